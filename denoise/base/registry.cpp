@@ -1,0 +1,44 @@
+#include "denoise/base/registry.h"
+
+#include <sstream>
+
+#include "denoise/util/error.h"
+
+namespace chorus {
+
+const std::vector<DenoiserEntry>& builtinDenoisers() {
+  // Each denoiser's file provides its entry; add new ones here, in the order `--help` lists them.
+  static const std::vector<DenoiserEntry> entries = {};
+  return entries;
+}
+
+std::unique_ptr<BaseDenoiser> createDenoiser(const std::string& spec) {
+  const size_t colon = spec.find(':');
+  const std::string name = spec.substr(0, colon);
+  for (const DenoiserEntry& entry : builtinDenoisers()) {
+    if (entry.name != name) continue;
+    ParamMap params =
+        colon == std::string::npos ? ParamMap() : ParamMap::parse(spec.substr(colon + 1), name);
+    auto denoiser = entry.create(params);
+    params.rejectUnread("denoiser " + name);
+    return denoiser;
+  }
+  std::string known;
+  for (const DenoiserEntry& entry : builtinDenoisers())
+    known += (known.empty() ? "" : ", ") + entry.name;
+  throw Error("unknown denoiser '" + name + "' (known: " + (known.empty() ? "none" : known) + ")");
+}
+
+std::vector<std::string> splitMethodList(const std::string& list) {
+  std::vector<std::string> specs;
+  std::stringstream stream(list);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    if (item.empty()) throw Error("empty method name in list '" + list + "'");
+    specs.push_back(item);
+  }
+  if (specs.empty()) throw Error("empty method list");
+  return specs;
+}
+
+}  // namespace chorus

@@ -1,0 +1,90 @@
+#pragma once
+// SampleBuffers: K statistically independent sub-buffers of the same pixels (K = 1, 2 or 4).
+// Each sub-buffer holds, per pixel, the mean and the variance of the mean of colour and of every
+// feature, plus its sample count. Denoisers never see SampleBuffers directly: they get a
+// DenoiseInput (the buffer to denoise plus, when available, two independent halves of it).
+#include <array>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "denoise/image/image.h"
+
+namespace chorus {
+
+// Mean and variance of the mean of one quantity, per pixel and channel.
+// varianceOfMean = M2 / (n (n - 1)) over the n samples kept (0 when n < 2); NaN means "no
+// sample of this quantity" (only possible in buffers read from other renderers).
+struct MeanVariance {
+  Image mean;
+  Image varianceOfMean;
+};
+
+// The quantities a sub-buffer records. Channel counts: color, albedo, normal 3; depth,
+// visibility 1.
+enum class Quantity { Color, Albedo, Normal, Depth, Visibility };
+inline constexpr std::array<Quantity, 5> kAllQuantities = {
+    Quantity::Color, Quantity::Albedo, Quantity::Normal, Quantity::Depth, Quantity::Visibility};
+int channelCount(Quantity q);
+// "color", "albedo", "normal", "depth", "visibility" (the names used in files and on the CLI).
+std::string_view quantityName(Quantity q);
+
+// One set of independent samples per pixel.
+struct SubBuffer {
+  MeanVariance color, albedo, normal, depth, visibility;
+  Image sampleCount;  // 1 channel: samples accumulated per pixel (non-finite samples dropped)
+
+  // An all-zero sub-buffer of the given size.
+  static SubBuffer zeros(int width, int height);
+
+  int width() const { return color.mean.width(); }
+  int height() const { return color.mean.height(); }
+  MeanVariance& get(Quantity q);
+  const MeanVariance& get(Quantity q) const;
+};
+
+// Exact merge of independent sub-buffers (Chan et al.'s parallel mean/M2 update, weighted by
+// sample counts): the result equals accumulating all their samples into one buffer.
+SubBuffer merge(const std::vector<const SubBuffer*>& parts);
+
+// What a base denoiser runs on: the buffer to denoise and, when the source has them, two
+// independent halves of exactly the same samples (whole = merge(halves)). Denoisers that need
+// halves of their own input (NFOR, dual-buffer NL-means, RDFC) use `halves`.
+struct DenoiseInput {
+  SubBuffer whole;
+  std::optional<std::array<SubBuffer, 2>> halves;
+
+  int width() const { return whole.width(); }
+  int height() const { return whole.height(); }
+};
+
+// Which part of a SampleBuffers an ensemble run denoises.
+enum class BufferPart { HalfA, HalfB, Full };
+std::string_view partName(BufferPart part);  // "A", "B", "full"
+
+class SampleBuffers {
+ public:
+  SampleBuffers() = default;
+  explicit SampleBuffers(std::vector<SubBuffer> subBuffers);
+
+  int splitCount() const { return int(subBuffers_.size()); }
+  int width() const { return subBuffers_.empty() ? 0 : subBuffers_[0].width(); }
+  int height() const { return subBuffers_.empty() ? 0 : subBuffers_[0].height(); }
+  const SubBuffer& sub(int k) const { return subBuffers_.at(size_t(k)); }
+  SubBuffer& sub(int k) { return subBuffers_.at(size_t(k)); }
+  const std::vector<SubBuffer>& subBuffers() const { return subBuffers_; }
+
+  // Merge of the listed sub-buffers.
+  SubBuffer merge(const std::vector<int>& indices) const;
+  // Half A = first half of the sub-buffers, half B = second half, full = all of them.
+  // Requires an even split count for the halves.
+  SubBuffer part(BufferPart which) const;
+  // The denoiser input for a part. With K = 4: half A gets quarters 0/1 as its halves, half B
+  // quarters 2/3, full gets A/B. With K = 2 only the full buffer has halves; with K = 1 none.
+  DenoiseInput input(BufferPart which) const;
+
+ private:
+  std::vector<SubBuffer> subBuffers_;
+};
+
+}  // namespace chorus

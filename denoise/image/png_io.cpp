@@ -1,0 +1,45 @@
+#include "denoise/image/png_io.h"
+
+#include <stb_image_write.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <vector>
+
+#include "denoise/util/atomic_file.h"
+#include "denoise/util/error.h"
+
+namespace chorus {
+
+void writePng(const std::filesystem::path& path, const Image& image,
+              const DisplayOptions& options) {
+  const int channels = image.channels();
+  if (channels != 1 && channels != 3 && channels != 4)
+    throw fileError(path, "PNG needs 1, 3 or 4 channels, not " + std::to_string(channels));
+  if (image.empty()) throw fileError(path, "cannot write an empty image");
+
+  std::vector<uint8_t> bytes(image.size());
+  for (size_t i = 0; i < image.size(); ++i) {
+    const bool alpha = channels == 4 && i % 4 == 3;
+    const float v = image.data()[i];
+    bytes[i] = alpha ? uint8_t(std::lround(255.0f * std::clamp(std::isnan(v) ? 0.0f : v, 0.0f, 1.0f)))
+                     : toDisplayByte(v, options);
+  }
+  std::vector<uint8_t> encoded;
+  auto append = [](void* context, void* data, int size) {
+    auto* out = static_cast<std::vector<uint8_t>*>(context);
+    out->insert(out->end(), static_cast<uint8_t*>(data), static_cast<uint8_t*>(data) + size);
+  };
+  if (!stbi_write_png_to_func(append, &encoded, image.width(), image.height(), channels,
+                              bytes.data(), image.width() * channels))
+    throw fileError(path, "PNG encoding failed");
+  writeAtomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(encoded.data()), std::streamsize(encoded.size()));
+    out.close();
+    if (!out) throw fileError(path, "cannot write");
+  });
+}
+
+}  // namespace chorus

@@ -1,0 +1,134 @@
+// SampleBuffers: merging sub-buffers equals accumulating their raw samples together, and the
+// denoiser inputs are built from the documented quarters.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <random>
+
+#include "denoise/util/error.h"
+
+#include "denoise/buffers/buffers_exr.h"
+#include "denoise/buffers/sample_buffers.h"
+#include "tests/support/test_support.h"
+
+namespace chorus {
+namespace {
+
+// Mean and variance of the mean of raw samples, computed directly (two-pass, double).
+std::pair<double, double> stats(const std::vector<double>& samples) {
+  const double n = double(samples.size());
+  double mean = 0;
+  for (double s : samples) mean += s / n;
+  double m2 = 0;
+  for (double s : samples) m2 += (s - mean) * (s - mean);
+  return {mean, n >= 2 ? m2 / (n * (n - 1)) : 0.0};
+}
+
+struct RawBuffers {
+  SampleBuffers buffers;
+  // (sub-buffer, pixel, quantity, channel) → samples
+  std::map<std::tuple<int, int, int, int>, std::vector<double>> samples;
+};
+
+RawBuffers makeRaw(int w, int h, int K) {
+  RawBuffers raw;
+  std::mt19937 rng(42);
+  std::normal_distribution<double> noise(0.5, 2.0);
+  std::vector<SubBuffer> subs;
+  for (int k = 0; k < K; ++k) {
+    SubBuffer sub = SubBuffer::zeros(w, h);
+    for (int p = 0; p < w * h; ++p) {
+      const int n = (p + k) % 5;  // unequal counts, including 0 and 1
+      sub.sampleCount.data()[p] = float(n);
+      for (int qi = 0; qi < int(kAllQuantities.size()); ++qi) {
+        const Quantity q = kAllQuantities[size_t(qi)];
+        for (int c = 0; c < channelCount(q); ++c) {
+          auto& s = raw.samples[{k, p, qi, c}];
+          for (int i = 0; i < n; ++i) s.push_back(noise(rng));
+          const auto [mean, var] = n > 0 ? stats(s) : std::pair<double, double>{0, 0};
+          sub.get(q).mean.data()[p * channelCount(q) + c] = float(mean);
+          sub.get(q).varianceOfMean.data()[p * channelCount(q) + c] = float(var);
+        }
+      }
+    }
+    subs.push_back(std::move(sub));
+  }
+  raw.buffers = SampleBuffers(std::move(subs));
+  return raw;
+}
+
+void expectMergeMatchesRaw(const RawBuffers& raw, const std::vector<int>& indices) {
+  const SubBuffer merged = raw.buffers.merge(indices);
+  const int pixels = raw.buffers.width() * raw.buffers.height();
+  for (int p = 0; p < pixels; ++p) {
+    for (int qi = 0; qi < int(kAllQuantities.size()); ++qi) {
+      const Quantity q = kAllQuantities[size_t(qi)];
+      for (int c = 0; c < channelCount(q); ++c) {
+        std::vector<double> all;
+        for (int k : indices) {
+          const auto& s = raw.samples.at({k, p, qi, c});
+          all.insert(all.end(), s.begin(), s.end());
+        }
+        if (all.empty()) continue;
+        const auto [mean, var] = stats(all);
+        EXPECT_NEAR(merged.get(q).mean.data()[p * channelCount(q) + c], mean, 1e-5)
+            << "pixel " << p << " " << quantityName(q);
+        EXPECT_NEAR(merged.get(q).varianceOfMean.data()[p * channelCount(q) + c], var,
+                    1e-5 * (1 + var))
+            << "pixel " << p << " " << quantityName(q);
+      }
+      EXPECT_EQ(merged.sampleCount.data()[p], [&] {
+        double n = 0;
+        for (int k : indices) n += double(raw.samples.at({k, p, 0, 0}).size());
+        return float(n);
+      }());
+    }
+  }
+}
+
+TEST(SampleBuffers, MergeMatchesStatisticsOfRawSamples) {
+  const RawBuffers raw = makeRaw(4, 3, 4);
+  expectMergeMatchesRaw(raw, {0, 1});
+  expectMergeMatchesRaw(raw, {2, 3});
+  expectMergeMatchesRaw(raw, {0, 1, 2, 3});
+  expectMergeMatchesRaw(raw, {3, 0, 2});
+}
+
+TEST(SampleBuffers, InputsUseTheDocumentedQuarters) {
+  const RawBuffers raw = makeRaw(4, 3, 4);
+  const DenoiseInput a = raw.buffers.input(BufferPart::HalfA);
+  ASSERT_TRUE(a.halves.has_value());
+  EXPECT_EQ(a.halves->at(0).color.mean.values()[5], raw.buffers.sub(0).color.mean.values()[5]);
+  EXPECT_EQ(a.halves->at(1).color.mean.values()[5], raw.buffers.sub(1).color.mean.values()[5]);
+  const DenoiseInput b = raw.buffers.input(BufferPart::HalfB);
+  EXPECT_EQ(b.halves->at(0).color.mean.values()[7], raw.buffers.sub(2).color.mean.values()[7]);
+  const DenoiseInput full = raw.buffers.input(BufferPart::Full);
+  ASSERT_TRUE(full.halves.has_value());
+  EXPECT_EQ(full.halves->at(1).color.mean.values()[3],
+            raw.buffers.merge({2, 3}).color.mean.values()[3]);
+
+  const RawBuffers two = makeRaw(2, 2, 2);
+  EXPECT_FALSE(two.buffers.input(BufferPart::HalfA).halves.has_value());
+  EXPECT_TRUE(two.buffers.input(BufferPart::Full).halves.has_value());
+}
+
+TEST(SampleBuffers, RenderExrLayoutRoundTrips) {
+  const RawBuffers raw = makeRaw(5, 4, 4);
+  test::TempDir dir;
+  writeExr(dir / "render.exr", sampleBuffersToLayers(raw.buffers));
+  const SampleBuffers back = sampleBuffersFromLayers(readExr(dir / "render.exr"), "render.exr");
+  ASSERT_EQ(back.splitCount(), 4);
+  for (int k = 0; k < 4; ++k)
+    for (Quantity q : kAllQuantities) {
+      EXPECT_EQ(back.sub(k).get(q).mean.values()[3], raw.buffers.sub(k).get(q).mean.values()[3]);
+      EXPECT_EQ(back.sub(k).get(q).varianceOfMean.values()[2],
+                raw.buffers.sub(k).get(q).varianceOfMean.values()[2]);
+    }
+  // The default layer is the full-buffer colour.
+  EXPECT_EQ(readExrLayer(dir / "render.exr").values()[4],
+            raw.buffers.part(BufferPart::Full).color.mean.values()[4]);
+  EXPECT_THROW(sampleBuffersFromLayers({{"", Image(2, 2, 3)}}, "x.exr"), Error);
+}
+
+}  // namespace
+}  // namespace chorus

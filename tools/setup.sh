@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# One-command setup for a fresh Debian (bookworm) machine:
+#   tools/setup.sh demo   install missing packages, build, render the default scene with denoising
+#   tools/setup.sh test   install missing packages, build, run the whole test suite (CTest)
+#   tools/setup.sh build  install missing packages and build only
+# Environment: BUILD_DIR (default build), JOBS (default: number of cores), CI=true adds -Werror.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+mode=${1:-demo}
+build_dir=${BUILD_DIR:-build}
+jobs=${JOBS:-$(nproc)}
+
+packages=(g++ cmake make pkg-config libembree-dev libtinygltf-dev libopenexr-dev libtbb-dev
+          libgtest-dev libeigen3-dev libcli11-dev libstb-dev nlohmann-json3-dev)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo=sudo
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+werror=OFF
+[ "${CI:-}" = "true" ] && werror=ON
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCHORUS_WERROR=$werror > /dev/null
+cmake --build "$build_dir" -j "$jobs"
+
+case "$mode" in
+  build) ;;
+  test)
+    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
+    ;;
+  demo)
+    out=out/cornell-box
+    "$build_dir"/chorus render scenes/cornell-box.gltf --out "$out"
+    echo "setup: wrote"
+    ls -l "$out"
+    ;;
+  *)
+    echo "usage: tools/setup.sh [demo|test|build]" >&2
+    exit 2
+    ;;
+esac

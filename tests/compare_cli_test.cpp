@@ -23,8 +23,8 @@ class CompareCli : public ::testing::Test {
 };
 
 TEST_F(CompareCli, PrintsJsonWithEveryMetric) {
-  const auto r = runChorus({"compare", (dir / "img.exr").string(), (dir / "ref.exr").string(),
-                            "--json"});
+  const auto r =
+      runChorus({"compare", (dir / "img.exr").string(), (dir / "ref.exr").string(), "--json"});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_NEAR(j.at("mse").get<double>(), 0.01, 1e-6);
@@ -65,8 +65,8 @@ TEST_F(CompareCli, ErrorsNameTheFile) {
       runChorus({"compare", (dir / "missing.exr").string(), (dir / "ref.exr").string()}),
       "missing.exr");
   std::ofstream(dir / "fake.exr") << "P3 1 1 255 0 0 0";
-  expectOneLineError(runChorus({"compare", (dir / "img.exr").string(), (dir / "fake.exr").string()}),
-                     "fake.exr");
+  expectOneLineError(
+      runChorus({"compare", (dir / "img.exr").string(), (dir / "fake.exr").string()}), "fake.exr");
   expectOneLineError(runChorus({"compare", (dir / "img.exr").string(), (dir / "ref.exr").string(),
                                 "--layer", "nope"}),
                      "nope");

@@ -2,8 +2,8 @@
 // clean errors on bad input.
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
-#include <ImfInputFile.h>
 #include <ImfHeader.h>
+#include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <gtest/gtest.h>
 
@@ -68,7 +68,8 @@ TEST(Exr, ChannelNamesFollowTheDocumentedScheme) {
   for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it)
     names.push_back(it.name());
   // EXR stores channels alphabetically.
-  EXPECT_EQ(names, (std::vector<std::string>{"B", "G", "R", "depth.Y", "n.A", "n.B", "n.G", "n.R"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"B", "G", "R", "depth.Y", "n.A", "n.B", "n.G", "n.R"}));
 }
 
 // Writes a file the way other tools do: plain R,G,B (or Y) channels, half, with a data window

@@ -37,8 +37,10 @@ SubBuffer readSubBuffer(const std::vector<ExrLayer>& layers, const std::string& 
   for (Quantity q : kAllQuantities) {
     const std::string name = std::string(quantityName(q));
     const bool defaultLayer = prefix.empty() && q == Quantity::Color;
-    sub.get(q).mean = requireLayer(layers, defaultLayer ? "" : prefix + name, channelCount(q), file);
-    sub.get(q).varianceOfMean = requireLayer(layers, prefix + name + "Variance", channelCount(q), file);
+    sub.get(q).mean =
+        requireLayer(layers, defaultLayer ? "" : prefix + name, channelCount(q), file);
+    sub.get(q).varianceOfMean =
+        requireLayer(layers, prefix + name + "Variance", channelCount(q), file);
   }
   sub.sampleCount = requireLayer(layers, prefix + "sampleCount", 1, file);
   return sub;

@@ -10,20 +10,28 @@ int channelCount(Quantity q) {
 
 std::string_view quantityName(Quantity q) {
   switch (q) {
-    case Quantity::Color: return "color";
-    case Quantity::Albedo: return "albedo";
-    case Quantity::Normal: return "normal";
-    case Quantity::Depth: return "depth";
-    case Quantity::Visibility: return "visibility";
+    case Quantity::Color:
+      return "color";
+    case Quantity::Albedo:
+      return "albedo";
+    case Quantity::Normal:
+      return "normal";
+    case Quantity::Depth:
+      return "depth";
+    case Quantity::Visibility:
+      return "visibility";
   }
   return "?";
 }
 
 std::string_view partName(BufferPart part) {
   switch (part) {
-    case BufferPart::HalfA: return "A";
-    case BufferPart::HalfB: return "B";
-    case BufferPart::Full: return "full";
+    case BufferPart::HalfA:
+      return "A";
+    case BufferPart::HalfB:
+      return "B";
+    case BufferPart::Full:
+      return "full";
   }
   return "?";
 }
@@ -40,11 +48,16 @@ SubBuffer SubBuffer::zeros(int width, int height) {
 
 MeanVariance& SubBuffer::get(Quantity q) {
   switch (q) {
-    case Quantity::Color: return color;
-    case Quantity::Albedo: return albedo;
-    case Quantity::Normal: return normal;
-    case Quantity::Depth: return depth;
-    case Quantity::Visibility: return visibility;
+    case Quantity::Color:
+      return color;
+    case Quantity::Albedo:
+      return albedo;
+    case Quantity::Normal:
+      return normal;
+    case Quantity::Depth:
+      return depth;
+    case Quantity::Visibility:
+      return visibility;
   }
   throw std::logic_error("SubBuffer::get: bad quantity");
 }
@@ -94,7 +107,8 @@ SubBuffer merge(const std::vector<const SubBuffer*>& parts) {
   return out;
 }
 
-SampleBuffers::SampleBuffers(std::vector<SubBuffer> subBuffers) : subBuffers_(std::move(subBuffers)) {
+SampleBuffers::SampleBuffers(std::vector<SubBuffer> subBuffers)
+    : subBuffers_(std::move(subBuffers)) {
   for (const SubBuffer& s : subBuffers_)
     if (s.width() != width() || s.height() != height())
       throw std::invalid_argument("SampleBuffers: sub-buffers differ in size");

@@ -1,12 +1,12 @@
 #include "denoise/image/exr_io.h"
 
+#include <Imath/half.h>
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfTestFile.h>
-#include <Imath/half.h>
 
 #include <algorithm>
 #include <fstream>
@@ -22,10 +22,14 @@ namespace {
 
 std::vector<std::string> suffixesFor(int channels) {
   switch (channels) {
-    case 1: return {"Y"};
-    case 2: return {"X", "Y"};
-    case 3: return {"R", "G", "B"};
-    case 4: return {"R", "G", "B", "A"};
+    case 1:
+      return {"Y"};
+    case 2:
+      return {"X", "Y"};
+    case 3:
+      return {"R", "G", "B"};
+    case 4:
+      return {"R", "G", "B", "A"};
     default: {
       std::vector<std::string> s;
       for (int c = 0; c < channels; ++c) s.push_back(std::to_string(c));
@@ -41,9 +45,9 @@ std::string channelName(const std::string& layer, const std::string& suffix) {
 // Sort key that puts a layer's channels in their conventional order (R G B A, X Y Z, Y, then
 // anything else alphabetically) instead of EXR's alphabetical order (B G R).
 int suffixRank(const std::string& suffix) {
-  static const std::map<std::string, int> ranks = {
-      {"R", 0}, {"r", 0}, {"X", 0}, {"x", 0}, {"G", 1}, {"g", 1}, {"Y", 1},
-      {"y", 1}, {"B", 2}, {"b", 2}, {"Z", 2}, {"z", 2}, {"A", 3}, {"a", 3}};
+  static const std::map<std::string, int> ranks = {{"R", 0}, {"r", 0}, {"X", 0}, {"x", 0}, {"G", 1},
+                                                   {"g", 1}, {"Y", 1}, {"y", 1}, {"B", 2}, {"b", 2},
+                                                   {"Z", 2}, {"z", 2}, {"A", 3}, {"a", 3}};
   auto it = ranks.find(suffix);
   if (it != ranks.end()) return it->second;
   // Numeric suffixes keep their numeric order after the named ones.
@@ -147,10 +151,9 @@ std::vector<ExrLayer> readExr(const fs::path& path) {
     }
     if (layerOrder.empty()) throw fileError(path, "no channels");
     // The default layer first, as viewers show it.
-    std::stable_sort(layerOrder.begin(), layerOrder.end(),
-                     [](const std::string& a, const std::string& b) {
-                       return a.empty() && !b.empty();
-                     });
+    std::stable_sort(
+        layerOrder.begin(), layerOrder.end(),
+        [](const std::string& a, const std::string& b) { return a.empty() && !b.empty(); });
 
     std::vector<ExrLayer> layers;
     Imf::FrameBuffer frame;
@@ -193,8 +196,8 @@ Image readExrLayer(const fs::path& path, const std::string& name) {
   std::string available;
   for (const ExrLayer& layer : layers)
     available += (available.empty() ? "" : ", ") + (layer.name.empty() ? "<default>" : layer.name);
-  throw fileError(path, "no layer '" + (name.empty() ? "<default>" : name) +
-                            "' (layers: " + available + ")");
+  throw fileError(
+      path, "no layer '" + (name.empty() ? "<default>" : name) + "' (layers: " + available + ")");
 }
 
 }  // namespace chorus

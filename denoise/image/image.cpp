@@ -22,11 +22,17 @@ float& Image::at(int x, int y, int c) {
   return data_[index(x, y, c)];
 }
 
-float Image::at(int x, int y, int c) const { return const_cast<Image*>(this)->at(x, y, c); }
+float Image::at(int x, int y, int c) const {
+  return const_cast<Image*>(this)->at(x, y, c);
+}
 
-void Image::fill(float value) { std::fill(data_.begin(), data_.end(), value); }
+void Image::fill(float value) {
+  std::fill(data_.begin(), data_.end(), value);
+}
 
-Image Image::channel(int c) const { return channelRange(c, 1); }
+Image Image::channel(int c) const {
+  return channelRange(c, 1);
+}
 
 Image Image::channelRange(int first, int count) const {
   if (first < 0 || count < 0 || first + count > channels_)

@@ -23,8 +23,9 @@ void writePng(const std::filesystem::path& path, const Image& image,
   for (size_t i = 0; i < image.size(); ++i) {
     const bool alpha = channels == 4 && i % 4 == 3;
     const float v = image.data()[i];
-    bytes[i] = alpha ? uint8_t(std::lround(255.0f * std::clamp(std::isnan(v) ? 0.0f : v, 0.0f, 1.0f)))
-                     : toDisplayByte(v, options);
+    bytes[i] = alpha
+                   ? uint8_t(std::lround(255.0f * std::clamp(std::isnan(v) ? 0.0f : v, 0.0f, 1.0f)))
+                   : toDisplayByte(v, options);
   }
   std::vector<uint8_t> encoded;
   auto append = [](void* context, void* data, int size) {

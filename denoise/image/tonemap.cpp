@@ -18,8 +18,11 @@ float tonemap(float linear, const DisplayOptions& options) {
   float v = linear * std::exp2(options.exposureStops);
   if (!(v > 0.0f)) return 0.0f;  // negatives and NaN
   switch (options.tonemapper) {
-    case Tonemapper::Clamp: break;
-    case Tonemapper::Reinhard: v = std::isinf(v) ? 1.0f : v / (1.0f + v); break;
+    case Tonemapper::Clamp:
+      break;
+    case Tonemapper::Reinhard:
+      v = std::isinf(v) ? 1.0f : v / (1.0f + v);
+      break;
     case Tonemapper::AcesFit:
       v = std::isinf(v) ? 1.0f : (v * (2.51f * v + 0.03f)) / (v * (2.43f * v + 0.59f) + 0.14f);
       break;

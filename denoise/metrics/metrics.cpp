@@ -13,10 +13,10 @@ namespace {
 
 void checkShapes(const Image& image, const Image& reference) {
   if (!image.sameShape(reference))
-    throw Error("image is " + std::to_string(image.width()) + "x" +
-                std::to_string(image.height()) + "x" + std::to_string(image.channels()) +
-                " but the reference is " + std::to_string(reference.width()) + "x" +
-                std::to_string(reference.height()) + "x" + std::to_string(reference.channels()));
+    throw Error("image is " + std::to_string(image.width()) + "x" + std::to_string(image.height()) +
+                "x" + std::to_string(image.channels()) + " but the reference is " +
+                std::to_string(reference.width()) + "x" + std::to_string(reference.height()) + "x" +
+                std::to_string(reference.channels()));
   if (image.empty()) throw Error("cannot compare empty images");
 }
 
@@ -29,7 +29,9 @@ double meanOver(const Image& image, const Image& reference, PerValue perValue) {
   return sum / double(image.size());
 }
 
-double displayValue(double v) { return std::pow(std::clamp(v, 0.0, 1.0), 1.0 / 2.2); }
+double displayValue(double v) {
+  return std::pow(std::clamp(v, 0.0, 1.0), 1.0 / 2.2);
+}
 
 // Normalised 1-D Gaussian taps of the SSIM window.
 std::vector<double> gaussianTaps(int size, double sigma) {
@@ -53,14 +55,16 @@ std::vector<double> filterValid(const std::vector<double>& plane, int w, int h,
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < ow; ++x) {
       double s = 0;
-      for (int i = 0; i < kx; ++i) s += wx[size_t(i)] * plane[size_t(y) * size_t(w) + size_t(x + i)];
+      for (int i = 0; i < kx; ++i)
+        s += wx[size_t(i)] * plane[size_t(y) * size_t(w) + size_t(x + i)];
       rows[size_t(y) * size_t(ow) + size_t(x)] = s;
     }
   std::vector<double> out(size_t(ow) * size_t(oh));
   for (int y = 0; y < oh; ++y)
     for (int x = 0; x < ow; ++x) {
       double s = 0;
-      for (int j = 0; j < ky; ++j) s += wy[size_t(j)] * rows[size_t(y + j) * size_t(ow) + size_t(x)];
+      for (int j = 0; j < ky; ++j)
+        s += wy[size_t(j)] * rows[size_t(y + j) * size_t(ow) + size_t(x)];
       out[size_t(y) * size_t(ow) + size_t(x)] = s;
     }
   return out;

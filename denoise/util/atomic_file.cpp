@@ -24,7 +24,8 @@ void ensureDirectory(const fs::path& dir) {
   if (dir.empty()) return;
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) throw fileError(dir, "cannot create directory: " + ec.message());
+  if (ec || !fs::is_directory(dir))
+    throw fileError(dir, "cannot create directory: " + ec.message());
 }
 
 void writeAtomically(const fs::path& target, const std::function<void(const fs::path&)>& write) {

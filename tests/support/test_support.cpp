@@ -58,7 +58,9 @@ ProcessResult runChorus(const std::vector<std::string>& args) {
   return result;
 }
 
-fs::path sourceDir() { return CHORUS_SOURCE_DIR; }
+fs::path sourceDir() {
+  return CHORUS_SOURCE_DIR;
+}
 
 std::optional<fs::path> sharedDir() {
   if (const char* env = std::getenv("CHORUS_SHARED_DIR"); env && *env) {

@@ -40,9 +40,9 @@ std::filesystem::path sourceDir();
 std::optional<std::filesystem::path> sharedDir();
 
 // Skips the current test when ../shared is absent.
-#define CHORUS_REQUIRE_SHARED(var)                                        \
-  const auto var##_opt = ::chorus::test::sharedDir();                     \
-  if (!var##_opt) GTEST_SKIP() << "../shared is absent; skipping";        \
+#define CHORUS_REQUIRE_SHARED(var)                                 \
+  const auto var##_opt = ::chorus::test::sharedDir();              \
+  if (!var##_opt) GTEST_SKIP() << "../shared is absent; skipping"; \
   const std::filesystem::path var = *var##_opt
 
 // An image with i.i.d. uniform values in [lo, hi), seeded.

@@ -56,18 +56,20 @@ void runCompare(const CompareArgs& args) {
   }
   std::printf("image      %s\nreference  %s\nlayer      %s\nsize       %dx%dx%d\n",
               args.image.c_str(), args.reference.c_str(),
-              args.layer.empty() ? "<default>" : args.layer.c_str(), image.width(),
-              image.height(), image.channels());
-  std::printf("mse        %.6g\nrelmse     %.6g   (eps 0.01)\npsnr       %.4f dB (linear, peak 1)\n"
-              "ssim       %.6f (on clamp(v,0,1)^(1/2.2))\ndssim      %.6g\nsmape      %.6g\n",
-              m.mse, m.relMse, m.psnr, m.ssim, m.dssim, m.smape);
+              args.layer.empty() ? "<default>" : args.layer.c_str(), image.width(), image.height(),
+              image.channels());
+  std::printf(
+      "mse        %.6g\nrelmse     %.6g   (eps 0.01)\npsnr       %.4f dB (linear, peak 1)\n"
+      "ssim       %.6f (on clamp(v,0,1)^(1/2.2))\ndssim      %.6g\nsmape      %.6g\n",
+      m.mse, m.relMse, m.psnr, m.ssim, m.dssim, m.smape);
 }
 
 const RegisterCommand registration(10, [](CLI::App& app) {
   auto args = std::make_shared<CompareArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "compare", "Print error metrics (MSE, relMSE, PSNR, SSIM, DSSIM, SMAPE) of an EXR image "
-                 "against a reference EXR");
+      "compare",
+      "Print error metrics (MSE, relMSE, PSNR, SSIM, DSSIM, SMAPE) of an EXR image "
+      "against a reference EXR");
   cmd->add_option("image", args->image, "Image to evaluate (.exr)")->required();
   cmd->add_option("reference", args->reference, "Reference image (.exr)")->required();
   cmd->add_option("--layer", args->layer,

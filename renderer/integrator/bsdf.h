@@ -1,0 +1,74 @@
+#pragma once
+// The glTF 2.0 reference material model as a BSDF (glTF spec, Appendix B, plus the
+// KHR_materials_transmission / _ior / _specular / _volume extensions):
+//   - dielectric: Lambertian diffuse (baseColor) under a GGX specular layer with Fresnel
+//     (ior, specular / specularColor), or, with `transmission`, a rough dielectric BTDF;
+//   - metal: GGX reflection with Schlick Fresnel on baseColor;
+//   mixed by `metallic`. GGX is sampled by visible normals (Heitz 2018).
+//
+// Conventions (pbrt-v4 style):
+//   - All directions are in the local shading frame: z is the shading normal, pointing to the
+//     side the surface faces (its outside). wo and wi point away from the surface.
+//   - wo.z < 0 means the path arrives from inside: only meaningful for transmissive materials
+//     (the relative IOR is inverted). For opaque materials the integrator flips the frame so
+//     that wo.z > 0 before calling.
+//   - f() does NOT include the cosine |wi.z|.
+//   - Transmission carries radiance: f includes the 1/η² scaling of radiance crossing the
+//     boundary (η = relative IOR of the side wi is on over the side wo is on).
+//   - Roughness below kDeltaRoughness is treated as perfectly smooth: its lobes are Dirac
+//     deltas, f() and pdf() return 0 for them and only sample() produces them (isDelta = true).
+#include <optional>
+
+#include "renderer/math/vec.h"
+
+namespace chorus::render {
+
+inline constexpr float kDeltaRoughness = 1e-3f;  // perceptual roughness
+
+// The material at one surface point, after texture lookups (all colours linear).
+struct MaterialPoint {
+  Rgb baseColor{1.0f};
+  float metallic = 1.0f;    // glTF default
+  float roughness = 1.0f;   // perceptual roughness; GGX alpha = roughness²
+  float ior = 1.5f;         // KHR_materials_ior
+  float transmission = 0;   // KHR_materials_transmission (fraction of the dielectric part)
+  float specular = 1.0f;    // KHR_materials_specular specularFactor (0 → pure Lambertian)
+  Rgb specularColor{1.0f};  // KHR_materials_specular specularColorFactor (linear)
+  // Transmission without KHR_materials_volume is thin-walled per the glTF spec: light passes
+  // straight through (no refraction, no interior). With a volume, the surface bounds a solid.
+  bool thinWalled = true;
+};
+
+struct BsdfSample {
+  Rgb f;          // BSDF value (without cosine); for delta lobes the delta's weight
+  Vec3f wi;       // local frame
+  float pdf = 0;  // solid-angle pdf; for delta lobes the discrete lobe probability
+  bool isDelta = false;
+  bool isTransmission = false;  // wi is on the other side of the surface than wo
+};
+
+class Bsdf {
+ public:
+  explicit Bsdf(const MaterialPoint& material);
+
+  Rgb f(Vec3f wo, Vec3f wi) const;
+  // uLobe picks the lobe, u samples its direction. Returns nullopt when no direction results
+  // (e.g. a microfacet normal that reflects below the surface).
+  std::optional<BsdfSample> sample(Vec3f wo, float uLobe, Vec2f u) const;
+  float pdf(Vec3f wo, Vec3f wi) const;
+
+  // Every lobe is a delta (smooth glass, smooth metal): features are taken further down the
+  // path, at the first vertex where this is false.
+  bool isPurelySpecular() const;
+  // Transmits light at all (so the integrator keeps transmission paths and shadow rays
+  // pass thin-walled surfaces only where this is true).
+  bool hasTransmission() const;
+  // The value recorded in the albedo feature buffer: the material's overall reflectance colour
+  // (baseColor for diffuse and metals, weighted by the lobe mix).
+  Rgb albedo() const;
+
+ private:
+  MaterialPoint m_;
+};
+
+}  // namespace chorus::render

@@ -1,14 +1,19 @@
 #pragma once
-// 8-bit sRGB PNG output (through stb_image_write).
+// 8-bit sRGB PNG output through stb_image_write: to a file, or to memory (for data URIs).
+#include <cstdint>
 #include <filesystem>
+#include <vector>
 
 #include "denoise/image/image.h"
 #include "denoise/image/tonemap.h"
 
 namespace chorus {
 
-// Writes a 1- (grey), 3- (RGB) or 4-channel (RGBA, alpha written linearly) image as an 8-bit
-// PNG through `options`, atomically. Throws chorus::Error naming the file.
+// Encodes a 1- (grey), 3- (RGB) or 4-channel (RGBA, alpha written linearly) image as an 8-bit
+// PNG through `options`. Throws chorus::Error for other channel counts or an empty image.
+std::vector<uint8_t> encodePng(const Image& image, const DisplayOptions& options = {});
+
+// encodePng, written atomically. Throws chorus::Error naming the file.
 void writePng(const std::filesystem::path& path, const Image& image,
               const DisplayOptions& options = {});
 

@@ -13,6 +13,8 @@ jobs=${JOBS:-$(nproc)}
 
 packages=(g++ cmake make pkg-config libembree-dev libtinygltf-dev libopenexr-dev libtbb-dev
           libgtest-dev libeigen3-dev libcli11-dev libstb-dev nlohmann-json3-dev)
+# The report test loads report.html in a real browser.
+[ "$mode" = test ] && packages+=(chromium)
 
 missing=()
 for p in "${packages[@]}"; do

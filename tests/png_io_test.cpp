@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <stb_image.h>
 
+#include "denoise/image/false_color.h"
 #include "denoise/image/png_io.h"
 #include "denoise/util/error.h"
 #include "tests/support/test_support.h"
@@ -57,6 +58,29 @@ TEST(Png, RejectsUnsupportedChannelCounts) {
   test::TempDir dir;
   EXPECT_THROW(writePng(dir / "x.png", Image(2, 2, 2)), Error);
   EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
+}
+
+TEST(FalseColor, EndpointsAndMonotoneLuminance) {
+  Image ramp(11, 1, 1);
+  for (int x = 0; x <= 10; ++x) ramp(x, 0, 0) = float(x) / 10;
+  ramp(0, 0, 0) = -5.0f;  // clamps to the first stop
+  const Image colors = falseColor(ramp);
+  test::TempDir dir;
+  writePng(dir / "ramp.png", colors);
+  const auto bytes = decode(dir / "ramp.png", 3);
+  // The stops written as 8-bit: 0 → (0.15, 0.05, 0.35)·255 = (38, 13, 89), 1 → (250, 230, 38).
+  EXPECT_NEAR(bytes[0], 38, 1);
+  EXPECT_NEAR(bytes[1], 13, 1);
+  EXPECT_NEAR(bytes[2], 89, 1);
+  EXPECT_NEAR(bytes[30], 250, 1);
+  EXPECT_NEAR(bytes[31], 230, 1);
+  EXPECT_NEAR(bytes[32], 38, 1);
+  // Brightness grows along the ramp, so the map reads as ordered in grey too.
+  for (int x = 1; x <= 10; ++x)
+    EXPECT_GT(colors(x, 0, 0) * 0.2126f + colors(x, 0, 1) * 0.7152f + colors(x, 0, 2) * 0.0722f,
+              colors(x - 1, 0, 0) * 0.2126f + colors(x - 1, 0, 1) * 0.7152f +
+                  colors(x - 1, 0, 2) * 0.0722f)
+        << x;
 }
 
 }  // namespace

@@ -1,0 +1,111 @@
+#include "renderer/sampling/sampler.h"
+
+#include <array>
+
+namespace chorus::render {
+namespace {
+
+// 64-bit finaliser (the avalanche step of MurmurHash3): every input bit affects every output bit.
+constexpr uint64_t mix64(uint64_t x) {
+  x ^= x >> 33;
+  x *= 0xff51afd7ed558ccdull;
+  x ^= x >> 33;
+  x *= 0xc4ceb9fe1a85ec53ull;
+  x ^= x >> 33;
+  return x;
+}
+
+constexpr uint64_t hashCombine(uint64_t h, uint64_t v) {
+  return mix64(h ^ (v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2)));
+}
+
+inline uint32_t reverseBits(uint32_t x) {
+  x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+  return (x >> 16) | (x << 16);
+}
+
+// A seeded permutation of 32-bit words in which output bit k depends only on input bits 0..k
+// (Laine & Karras 2011): additions, odd multiplications and x ^= x * even all have this
+// property. Applied to bit-reversed values it flips each bit depending on all more significant
+// bits, which is Owen's nested uniform scrambling (Burley 2020, §3).
+inline uint32_t lowerBitsPermutation(uint32_t x, uint32_t seed) {
+  x += seed;
+  x ^= x * 0xf9b439fau;
+  x *= (seed >> 16) | 1u;
+  x ^= x * 0x91d93086u;
+  x += seed * 0xa05f1119u;
+  x ^= x * 0x8142c8eau;
+  x ^= x * 0x3ceaaf36u;
+  return x;
+}
+
+// Owen scrambling of a 32-bit binary fraction (most significant bit = first digit).
+inline uint32_t nestedUniformScramble(uint32_t x, uint32_t seed) {
+  return reverseBits(lowerBitsPermutation(reverseBits(x), seed));
+}
+
+// Generator matrix columns of the second Sobol dimension (primitive polynomial x + 1):
+// v_0 = 1/2, v_k = v_{k-1} xor (v_{k-1} / 2). The first dimension is the van der Corput
+// sequence (the identity matrix), and together they form a (0,2)-sequence in base 2.
+constexpr std::array<uint32_t, 32> makeSobolDimension1() {
+  std::array<uint32_t, 32> v{};
+  v[0] = 0x80000000u;
+  for (int k = 1; k < 32; ++k) v[k] = v[k - 1] ^ (v[k - 1] >> 1);
+  return v;
+}
+constexpr std::array<uint32_t, 32> kSobolDimension1 = makeSobolDimension1();
+
+inline uint32_t sobolDimension0(uint32_t index) {
+  return reverseBits(index);
+}
+
+inline uint32_t sobolDimension1(uint32_t index) {
+  uint32_t x = 0;
+  for (int k = 0; index != 0; ++k, index >>= 1)
+    if (index & 1u) x ^= kSobolDimension1[k];
+  return x;
+}
+
+// The top 24 bits as a float in [0, 1): exact, and never rounds up to 1.
+inline float toUnitFloat(uint32_t x) {
+  return float(x >> 8) * 0x1p-24f;
+}
+
+}  // namespace
+
+void Sampler::startPixelSample(int px, int py, uint32_t indexInSubBuffer, int subBuffer) {
+  uint64_t h = hashCombine(mix64(seed_), uint64_t(uint32_t(px)));
+  h = hashCombine(h, uint64_t(uint32_t(py)));
+  pixelHash_ = hashCombine(h, uint64_t(uint32_t(subBuffer)));
+  index_ = indexInSubBuffer;
+  dimension_ = 0;
+}
+
+// Every call draws from its own (0,2)-sequence: the pair of dimensions gets an independent
+// index shuffle and independent scrambles (Burley 2020, §4 "padding"), so the points of one
+// call are stratified within the pixel while different calls are mutually independent.
+Vec2f Sampler::get2D() {
+  const uint64_t h = hashCombine(pixelHash_, dimension_);
+  dimension_ += 2;
+  const uint64_t h2 = mix64(h);
+  const uint32_t shuffled = nestedUniformScramble(index_, uint32_t(h));
+  const uint32_t x = nestedUniformScramble(sobolDimension0(shuffled), uint32_t(h >> 32));
+  const uint32_t y = nestedUniformScramble(sobolDimension1(shuffled), uint32_t(h2));
+  return {toUnitFloat(x), toUnitFloat(y)};
+}
+
+float Sampler::get1D() {
+  const uint64_t h = hashCombine(pixelHash_, dimension_);
+  dimension_ += 1;
+  const uint32_t shuffled = nestedUniformScramble(index_, uint32_t(h));
+  return toUnitFloat(nestedUniformScramble(sobolDimension0(shuffled), uint32_t(h >> 32)));
+}
+
+Vec2f Sampler::getPixel2D() {
+  return get2D();
+}
+
+}  // namespace chorus::render

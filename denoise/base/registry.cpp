@@ -2,13 +2,18 @@
 
 #include <sstream>
 
+#include "denoise/base/sbf.h"
+
 #include "denoise/util/error.h"
 
 namespace chorus {
 
 const std::vector<DenoiserEntry>& builtinDenoisers() {
   // Each denoiser's file provides its entry; add new ones here, in the order `--help` lists them.
-  static const std::vector<DenoiserEntry> entries = {};
+  static const std::vector<DenoiserEntry> entries = {
+      {"sbf", "SURE-based selection among feature-guided cross-bilateral filters (Li et al. 2012)",
+       [](ParamMap& p) { return std::make_unique<Sbf>(SbfParams::fromParams(p)); }},
+  };
   return entries;
 }
 

@@ -1,0 +1,56 @@
+#pragma once
+// SURE-based filtering (Li, Wu, Chuang, "SURE-based Optimization for Adaptive Sampling and
+// Reconstruction", SIGGRAPH Asia 2012), reconstruction part; values as in
+// ../shared/docs/base-denoisers.md §5:
+//   1. one feature-guided cross-bilateral candidate per spatial width σ_s (cross_bilateral.h),
+//      with per-sample feature variances and no colour range term (as in the authors' release);
+//   2. SURE of every candidate per pixel, from the colour's variance of the mean (sure.h);
+//   3. every SURE map smoothed by a feature-only cross-bilateral of width sigmaMse;
+//   4. per pixel the candidate with the smallest smoothed SURE (hard selection, no blending).
+// Deviation: no adaptive sampling (chorus renders a fixed budget), so only the final-image
+// settings are used.
+#include <string>
+#include <vector>
+
+#include "denoise/base/base_denoiser.h"
+#include "denoise/base/param_map.h"
+
+namespace chorus {
+
+struct SbfParams {
+  // Candidate spatial widths σ_s in pixels (window radius round(2σ_s); 0 = the noisy input).
+  // The paper's set was not found in the indexed sources: {0, 1, 2, 4, 8} is our assumption.
+  std::vector<float> sigmaS = {0, 1, 2, 4, 8};
+  float sigmaN = 0.8f;    // normal range width (release / pbrt-v3 port default)
+  float sigmaR = 0.25f;   // reflectance (albedo, "texture") range width (same source)
+  float sigmaD = 0.6f;    // depth range width, depth divided by the largest finite depth
+  float sigmaMse = 8.0f;  // spatial width of the SURE-map smoothing (final image; 4 while
+                          // sampling adaptively in the release)
+
+  // Reads overrides: sigmaS=0/1/2/4/8 (slash-separated), sigmaN, sigmaR, sigmaD, sigmaMse.
+  // Throws chorus::Error for a value out of range.
+  static SbfParams fromParams(ParamMap& params);
+};
+
+struct SbfResult {
+  Image output;     // RGB
+  Image selection;  // 1 channel: index into sigmaS of the candidate chosen per pixel
+};
+
+// Runs SBF on one buffer (colour, its variance of the mean, normal, albedo, depth, sample count).
+SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params);
+
+class Sbf : public BaseDenoiser {
+ public:
+  explicit Sbf(SbfParams params = {}) : params_(std::move(params)) {}
+  std::string name() const override { return "sbf"; }
+  DenoiserRequirements requirements() const override { return {.features = true, .halves = false}; }
+  Image run(const DenoiseInput& input) const override {
+    return runSbf(input.whole, params_).output;
+  }
+
+ private:
+  SbfParams params_;
+};
+
+}  // namespace chorus

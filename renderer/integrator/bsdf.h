@@ -17,8 +17,19 @@
 //     boundary (η = relative IOR of the side wi is on over the side wo is on).
 //   - Roughness below kDeltaRoughness is treated as perfectly smooth: its lobes are Dirac
 //     deltas, f() and pdf() return 0 for them and only sample() produces them (isDelta = true).
+//     For a delta sample, f·|wi.z| / pdf is the path throughput weight, exactly as for other
+//     samples (f carries the 1/|wi.z| of the delta, as in pbrt).
+//   - sample() of a non-delta lobe returns the value and pdf of all non-delta lobes together
+//     for that direction (equal to f(wo, wi) and pdf(wo, wi)), so MIS weights use pdf().
+//
+// Layering (see README "BSDF"): the diffuse base receives exactly the energy the GGX specular
+// layer does not reflect, via albedo scaling with the layer's directional albedo E(μ):
+//   f_diffuse = baseColor/π · (1 − E(μo)) (1 − E(μi)) / (1 − E_avg),
+// which is reciprocal and keeps ∫ f cos ≤ 1 (the spec's per-half-vector (1 − F) weighting is
+// not white-furnace-safe at grazing angles). specular = 0 gives exactly baseColor/π.
 #include <optional>
 
+#include "renderer/integrator/microfacet.h"
 #include "renderer/math/vec.h"
 
 namespace chorus::render {
@@ -68,7 +79,24 @@ class Bsdf {
   Rgb albedo() const;
 
  private:
-  MaterialPoint m_;
+  struct LobeWeights;
+  LobeWeights lobeWeights(Vec3f wo, bool inside) const;
+  Rgb dielectricFresnel(float cosTheta, bool inside, bool* transmits) const;
+  float layerAlbedo(float cosTheta) const;  // E(μ) of the specular layer, max over channels
+  Rgb diffuseF(Vec3f wo, Vec3f wi) const;
+  Rgb fCanonical(Vec3f wo, Vec3f wi, bool inside) const;
+  float pdfCanonical(Vec3f wo, Vec3f wi, bool inside, const LobeWeights& weights) const;
+  float reflectTransmitChoice(const Rgb& fresnel, bool transmits) const;
+
+  MaterialPoint m_;  // clamped to valid ranges
+  GgxDistribution ggx_{1.0f};
+  bool smooth_ = false;
+  bool solidTransmission_ = false;  // refracts into a closed volume (wo.z < 0 is inside)
+  float eta_ = 1.5f;                // IOR used by the interface (clamped away from 1)
+  Rgb f0_;                          // dielectric normal reflectance per channel, before specular
+  float f0Max_ = 0;
+  float averageLayerAlbedo_ = 0;  // E_avg, max over channels
+  Rgb averageLayerAlbedoRgb_;     // E_avg per channel, for albedo()
 };
 
 }  // namespace chorus::render

@@ -1,0 +1,333 @@
+#include "renderer/integrator/bsdf.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "renderer/integrator/fresnel.h"
+#include "renderer/integrator/specular_albedo.h"
+#include "renderer/sampling/warps.h"
+
+namespace chorus::render {
+namespace {
+
+// A solid needs a relative IOR away from 1: at η = 1 every microfacet refracts straight through
+// and the rough BTDF degenerates into a delta.
+constexpr float kMinIor = 1.01f, kMaxIor = 4.0f;
+// Below this the diffuse base receives no energy at all (a perfect mirror coating).
+constexpr float kMinBaseEnergy = 1e-4f;
+// Rough lobes whose weight estimate at the macro normal is 0 (black metal seen head-on, glass
+// at total internal reflection) can still scatter through tilted microfacets: keep sampling them.
+constexpr float kMinRoughLobeWeight = 0.05f;
+// Directions closer to the tangent plane than this scatter nothing: the microfacet terms'
+// 1 / (cos θo cos θi) would underflow to 0 / 0.
+constexpr float kMinCosine = 1e-7f;
+
+float clamp01(float v) {
+  return v >= 0 ? std::min(v, 1.0f) : 0.0f;  // also maps NaN to 0
+}
+Rgb clamp01(Rgb c) {
+  return {clamp01(c.r), clamp01(c.g), clamp01(c.b)};
+}
+Vec3f mirrorZ(Vec3f v) {
+  return {v.x, v.y, -v.z};
+}
+bool grazingSafe(Vec3f w) {
+  return std::abs(w.z) >= kMinCosine && isFinite(w);
+}
+bool finiteInputs(Vec3f v, float uLobe, Vec2f u) {
+  return isFinite(v) && std::isfinite(uLobe) && std::isfinite(u.x) && std::isfinite(u.y);
+}
+
+// Smooth limit of the layer albedo terms: E = F(μ); its average 2∫ (1 − μ)^5 μ dμ = 1/21.
+SpecularAlbedoTerms smoothLayerTerms(float cosTheta) {
+  const float w = schlickWeight(cosTheta);
+  return {1.0f - w, w};
+}
+constexpr SpecularAlbedoTerms kSmoothLayerAverage{20.0f / 21.0f, 1.0f / 21.0f};
+
+}  // namespace
+
+// Probabilities of choosing each lobe family in sample(); they sum to 1 (or are all 0 when the
+// material scatters nothing from this direction).
+struct Bsdf::LobeWeights {
+  float diffuse = 0, metal = 0, interface = 0;
+  bool any() const { return diffuse + metal + interface > 0; }
+};
+
+Bsdf::Bsdf(const MaterialPoint& material) : m_(material) {
+  m_.baseColor = clamp01(material.baseColor);
+  m_.metallic = clamp01(material.metallic);
+  m_.roughness = clamp01(material.roughness);
+  m_.transmission = clamp01(material.transmission);
+  m_.specular = clamp01(material.specular);
+  m_.specularColor = {std::max(0.0f, material.specularColor.r),
+                      std::max(0.0f, material.specularColor.g),
+                      std::max(0.0f, material.specularColor.b)};
+  m_.ior = std::isfinite(material.ior) ? std::clamp(material.ior, kMinIor, kMaxIor) : 1.5f;
+  eta_ = m_.ior;
+  smooth_ = m_.roughness < kDeltaRoughness;
+  ggx_ = GgxDistribution::fromRoughness(m_.roughness);
+  solidTransmission_ = !m_.thinWalled && hasTransmission();
+
+  // KHR_materials_specular: f0 = min(f0(ior) · specularColor, 1) · specular, f90 = specular.
+  const float f0Ior = f0FromIor(eta_);
+  f0_ = {std::min(f0Ior * m_.specularColor.r, 1.0f), std::min(f0Ior * m_.specularColor.g, 1.0f),
+         std::min(f0Ior * m_.specularColor.b, 1.0f)};
+  f0Max_ = f0_.maxComponent();
+  const SpecularAlbedoTerms average =
+      smooth_ ? kSmoothLayerAverage : specularAlbedoAverage(m_.roughness);
+  averageLayerAlbedo_ = m_.specular * average.albedo(f0Max_, 1.0f);
+  averageLayerAlbedoRgb_ =
+      Rgb(average.albedo(f0_.r, 1.0f), average.albedo(f0_.g, 1.0f), average.albedo(f0_.b, 1.0f)) *
+      m_.specular;
+}
+
+// Fresnel reflectance of the dielectric layer: Schlick at the cosine on the outer side, so
+// that reflection and transmission agree from both sides of a solid; from inside beyond the
+// critical angle everything the layer passes is reflected (*transmits = false).
+Rgb Bsdf::dielectricFresnel(float cosTheta, bool inside, bool* transmits) const {
+  const float cosOuter = inside ? outerCosine(cosTheta, 1.0f / eta_) : cosTheta;
+  *transmits = cosOuter >= 0;
+  if (!*transmits) return Rgb(m_.specular);
+  return schlickFresnel(f0_, 1.0f, cosOuter) * m_.specular;
+}
+
+float Bsdf::layerAlbedo(float cosTheta) const {
+  const SpecularAlbedoTerms terms =
+      smooth_ ? smoothLayerTerms(cosTheta) : specularAlbedo(cosTheta, m_.roughness);
+  return std::min(1.0f, m_.specular * terms.albedo(f0Max_, 1.0f));
+}
+
+// Probability of reflecting (rather than transmitting) at a microfacet with Fresnel `fresnel`,
+// proportional to the two weights the BSDF gives them.
+float Bsdf::reflectTransmitChoice(const Rgb& fresnel, bool transmits) const {
+  const float reflect = fresnel.average();
+  const float transmit =
+      transmits ? m_.transmission * m_.baseColor.average() * (1.0f - fresnel.maxComponent()) : 0;
+  if (!(reflect + transmit > 0)) return 1.0f;
+  return reflect / (reflect + transmit);
+}
+
+Bsdf::LobeWeights Bsdf::lobeWeights(Vec3f wo, bool inside) const {
+  LobeWeights w;
+  const float dielectric = 1.0f - m_.metallic;
+  const float baseAverage = m_.baseColor.average();
+  if (!inside) {
+    if (1.0f - averageLayerAlbedo_ > kMinBaseEnergy)
+      w.diffuse = dielectric * (1.0f - m_.transmission) * baseAverage * (1.0f - layerAlbedo(wo.z));
+    w.metal = m_.metallic * schlickFresnel(m_.baseColor, 1.0f, wo.z).average();
+    if (!smooth_) w.metal = std::max(w.metal, m_.metallic * kMinRoughLobeWeight);
+  }
+  bool transmits;
+  const Rgb fresnel = dielectricFresnel(wo.z, inside, &transmits);
+  float transmit = transmits ? m_.transmission * baseAverage * (1.0f - fresnel.maxComponent()) : 0;
+  if (!smooth_) transmit = std::max(transmit, m_.transmission * baseAverage * kMinRoughLobeWeight);
+  w.interface = dielectric * (fresnel.average() + transmit);
+
+  const float total = w.diffuse + w.metal + w.interface;
+  if (!(total > 0)) return {};
+  w.diffuse /= total;
+  w.metal /= total;
+  w.interface /= total;
+  return w;
+}
+
+// Albedo-scaled Lambertian base (see bsdf.h): reciprocal, and ∫ f cos = ρ (1 − E(μo)).
+Rgb Bsdf::diffuseF(Vec3f wo, Vec3f wi) const {
+  const float baseEnergy = 1.0f - averageLayerAlbedo_;
+  if (!(baseEnergy > kMinBaseEnergy)) return {};
+  const float weight = (1.0f - m_.metallic) * (1.0f - m_.transmission);
+  if (weight == 0) return {};
+  if (m_.specular == 0) return m_.baseColor * (weight * kInvPi);  // exactly Lambertian
+  const float scale =
+      (1.0f - layerAlbedo(wo.z)) * (1.0f - layerAlbedo(wi.z)) / baseEnergy * weight * kInvPi;
+  return m_.baseColor * scale;
+}
+
+// f for wo.z > 0; `inside` means wo is inside a solid transmissive object.
+Rgb Bsdf::fCanonical(Vec3f wo, Vec3f wi, bool inside) const {
+  const float dielectric = 1.0f - m_.metallic;
+  Rgb f;
+  if (wi.z > 0) {
+    if (!inside) f += diffuseF(wo, wi);
+    if (smooth_) return f;
+    const Vec3f h = normalize(wo + wi);
+    const float cosOH = dot(wo, h);
+    const float microfacet = ggx_.D(h) * ggx_.G(wo, wi) / (4.0f * wo.z * wi.z);
+    if (!inside && m_.metallic > 0)
+      f += schlickFresnel(m_.baseColor, 1.0f, cosOH) * (m_.metallic * microfacet);
+    if (dielectric > 0) {
+      bool transmits;
+      f += dielectricFresnel(cosOH, inside, &transmits) * (dielectric * microfacet);
+    }
+    return f;
+  }
+  if (wi.z == 0 || smooth_ || !hasTransmission()) return f;
+
+  const float weight = dielectric * m_.transmission;
+  if (!solidTransmission_) {
+    // Thin-walled: the reflection lobe mirrored through the surface (no refraction).
+    const Vec3f wr = mirrorZ(wi);
+    const Vec3f h = normalize(wo + wr);
+    bool transmits;
+    const Rgb fresnel = dielectricFresnel(dot(wo, h), false, &transmits);
+    const float microfacet = ggx_.D(h) * ggx_.G(wo, wr) / (4.0f * wo.z * wr.z);
+    return m_.baseColor * (weight * (1.0f - fresnel.maxComponent()) * microfacet);
+  }
+  // Walter et al. 2007, eq. 21, with the radiance scaling 1/η² (η = n_wi / n_wo):
+  // f = |wi·h| |wo·h| / (|wi.z| wo.z) · D G (1 − F) / (wo·h + η wi·h)².
+  const float eta = inside ? 1.0f / eta_ : eta_;
+  const Vec3f halfway = wo + wi * eta;
+  if (!(lengthSquared(halfway) > 1e-12f)) return f;
+  const Vec3f h = faceForward(normalize(halfway), Vec3f(0, 0, 1));
+  const float cosOH = dot(wo, h), cosIH = dot(wi, h);
+  if (cosOH <= 0 || cosIH >= 0) return f;
+  bool transmits;
+  const Rgb fresnel = dielectricFresnel(cosOH, inside, &transmits);
+  if (!transmits) return f;
+  const float denom = cosOH + eta * cosIH;
+  const float value =
+      ggx_.D(h) * ggx_.G(wo, wi) * (-cosIH) * cosOH / (wo.z * -wi.z * denom * denom);
+  return m_.baseColor * (weight * (1.0f - fresnel.maxComponent()) * value);
+}
+
+float Bsdf::pdfCanonical(Vec3f wo, Vec3f wi, bool inside, const LobeWeights& w) const {
+  float pdf = 0;
+  if (wi.z > 0) {
+    if (w.diffuse > 0) pdf += w.diffuse * cosineHemispherePdfSolidAngle(wi.z);
+    if (smooth_ || (w.metal == 0 && w.interface == 0)) return pdf;
+    const Vec3f h = normalize(wo + wi);
+    const float cosOH = dot(wo, h);
+    const float reflectPdf = ggx_.visibleNormalPdf(wo, h) / (4.0f * cosOH);
+    pdf += w.metal * reflectPdf;
+    if (w.interface > 0) {
+      bool transmits;
+      const Rgb fresnel = dielectricFresnel(cosOH, inside, &transmits);
+      pdf += w.interface * reflectTransmitChoice(fresnel, transmits) * reflectPdf;
+    }
+    return pdf;
+  }
+  if (wi.z == 0 || smooth_ || w.interface == 0 || !hasTransmission()) return pdf;
+
+  if (!solidTransmission_) {
+    const Vec3f h = normalize(wo + mirrorZ(wi));
+    const float cosOH = dot(wo, h);
+    bool transmits;
+    const Rgb fresnel = dielectricFresnel(cosOH, false, &transmits);
+    const float transmitChoice = 1.0f - reflectTransmitChoice(fresnel, transmits);
+    return w.interface * transmitChoice * ggx_.visibleNormalPdf(wo, h) / (4.0f * cosOH);
+  }
+  const float eta = inside ? 1.0f / eta_ : eta_;
+  const Vec3f halfway = wo + wi * eta;
+  if (!(lengthSquared(halfway) > 1e-12f)) return pdf;
+  const Vec3f h = faceForward(normalize(halfway), Vec3f(0, 0, 1));
+  const float cosOH = dot(wo, h), cosIH = dot(wi, h);
+  if (cosOH <= 0 || cosIH >= 0) return pdf;
+  bool transmits;
+  const Rgb fresnel = dielectricFresnel(cosOH, inside, &transmits);
+  if (!transmits) return pdf;
+  // dωh/dωi = η² |wi·h| / (wo·h + η wi·h)² (Walter et al. 2007, eq. 17).
+  const float denom = cosOH + eta * cosIH;
+  const float jacobian = eta * eta * (-cosIH) / (denom * denom);
+  const float transmitChoice = 1.0f - reflectTransmitChoice(fresnel, transmits);
+  return w.interface * transmitChoice * ggx_.visibleNormalPdf(wo, h) * jacobian;
+}
+
+Rgb Bsdf::f(Vec3f wo, Vec3f wi) const {
+  if (!grazingSafe(wo) || !grazingSafe(wi)) return {};
+  const bool flip = wo.z < 0;
+  const bool inside = flip && solidTransmission_;
+  return fCanonical(flip ? mirrorZ(wo) : wo, flip ? mirrorZ(wi) : wi, inside);
+}
+
+float Bsdf::pdf(Vec3f wo, Vec3f wi) const {
+  if (!grazingSafe(wo) || !grazingSafe(wi)) return 0;
+  const bool flip = wo.z < 0;
+  const bool inside = flip && solidTransmission_;
+  const Vec3f o = flip ? mirrorZ(wo) : wo;
+  return pdfCanonical(o, flip ? mirrorZ(wi) : wi, inside, lobeWeights(o, inside));
+}
+
+std::optional<BsdfSample> Bsdf::sample(Vec3f woAsGiven, float uLobe, Vec2f u) const {
+  if (!grazingSafe(woAsGiven) || !finiteInputs(woAsGiven, uLobe, u)) return std::nullopt;
+  const bool flip = woAsGiven.z < 0;
+  const bool inside = flip && solidTransmission_;
+  const Vec3f wo = flip ? mirrorZ(woAsGiven) : woAsGiven;
+  const LobeWeights w = lobeWeights(wo, inside);
+  if (!w.any()) return std::nullopt;
+  const auto finish = [&](BsdfSample s) -> std::optional<BsdfSample> {
+    if (!(s.pdf > 0) || !s.f.isFinite() || !isFinite(s.wi)) return std::nullopt;
+    s.isTransmission = s.wi.z < 0;
+    if (flip) s.wi = mirrorZ(s.wi);
+    return s;
+  };
+  const auto nonDelta = [&](Vec3f wi) -> std::optional<BsdfSample> {
+    if (!grazingSafe(wi)) return std::nullopt;
+    return finish({fCanonical(wo, wi, inside), wi, pdfCanonical(wo, wi, inside, w), false, false});
+  };
+
+  // Diffuse: cosine-weighted hemisphere.
+  if (uLobe < w.diffuse || w.metal + w.interface == 0) return nonDelta(sampleCosineHemisphere(u));
+
+  // Metal: GGX reflection sampled by visible normals, or a mirror.
+  if (uLobe < w.diffuse + w.metal || w.interface == 0) {
+    if (smooth_) {
+      const Vec3f wi{-wo.x, -wo.y, wo.z};
+      const Rgb fresnel = schlickFresnel(m_.baseColor, 1.0f, wo.z);
+      return finish({fresnel * (m_.metallic / wo.z), wi, w.metal, true, false});
+    }
+    const Vec3f wi = reflect(wo, ggx_.sampleVisibleNormal(wo, u));
+    if (wi.z <= 0) return std::nullopt;
+    return nonDelta(wi);
+  }
+
+  // Dielectric interface: choose reflection or transmission at the microfacet in proportion to
+  // their weights, reusing the remainder of uLobe.
+  const float uChoice =
+      std::clamp((uLobe - w.diffuse - w.metal) / w.interface, 0.0f, 0x1.fffffep-1f);
+  const float dielectric = 1.0f - m_.metallic;
+  const float eta = inside ? 1.0f / eta_ : eta_;
+  const Vec3f h = smooth_ ? Vec3f(0, 0, 1) : ggx_.sampleVisibleNormal(wo, u);
+  const float cosOH = dot(wo, h);
+  bool transmits;
+  const Rgb fresnel = dielectricFresnel(cosOH, inside, &transmits);
+  const float reflectChoice = reflectTransmitChoice(fresnel, transmits);
+  const bool reflection = uChoice < reflectChoice;
+
+  Vec3f wi;
+  if (reflection) {
+    wi = reflect(wo, h);
+    if (wi.z <= 0) return std::nullopt;
+  } else if (!solidTransmission_) {
+    wi = mirrorZ(reflect(wo, h));
+    if (wi.z >= 0) return std::nullopt;
+  } else {
+    if (!refract(wo, h, eta, &wi) || wi.z >= 0) return std::nullopt;
+  }
+  if (!smooth_) return nonDelta(wi);
+
+  // Smooth: Dirac deltas, f carries 1 / |cos θi| (and 1/η² for refraction).
+  const float lobePdf = w.interface * (reflection ? reflectChoice : 1.0f - reflectChoice);
+  if (reflection) return finish({fresnel * (dielectric / wi.z), wi, lobePdf, true, false});
+  const float transmittance = dielectric * m_.transmission * (1.0f - fresnel.maxComponent());
+  const float radianceScale = solidTransmission_ ? 1.0f / (eta * eta) : 1.0f;
+  return finish({m_.baseColor * (transmittance * radianceScale / -wi.z), wi, lobePdf, true, false});
+}
+
+bool Bsdf::isPurelySpecular() const {
+  const bool diffuse =
+      (1.0f - m_.metallic) * (1.0f - m_.transmission) * m_.baseColor.maxComponent() > 0 &&
+      1.0f - averageLayerAlbedo_ > kMinBaseEnergy;
+  return smooth_ && !diffuse;
+}
+
+bool Bsdf::hasTransmission() const {
+  return (1.0f - m_.metallic) * m_.transmission > 0 && m_.baseColor.maxComponent() > 0;
+}
+
+Rgb Bsdf::albedo() const {
+  const Rgb dielectric = averageLayerAlbedoRgb_ + m_.baseColor * (1.0f - averageLayerAlbedo_);
+  return dielectric * (1.0f - m_.metallic) + m_.baseColor * m_.metallic;
+}
+
+}  // namespace chorus::render

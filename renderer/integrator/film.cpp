@@ -1,0 +1,74 @@
+#include "renderer/integrator/film.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace chorus::render {
+namespace {
+
+std::array<float, kPathSampleChannels> channels(const PathSample& s) {
+  return {s.L.r,      s.L.g,      s.L.b,      s.albedo.r, s.albedo.g,  s.albedo.b,
+          s.normal.x, s.normal.y, s.normal.z, s.depth,    s.visibility};
+}
+
+}  // namespace
+
+bool PathSample::isFinite() const {
+  for (float v : channels(*this))
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+bool PixelAccumulator::add(int k, const PathSample& sample) {
+  if (!sample.isFinite()) return false;
+  Stats& s = stats_[size_t(k)];
+  ++s.count;
+  const double n = s.count;
+  const auto values = channels(sample);
+  for (size_t c = 0; c < values.size(); ++c) {
+    // Welford: mean_n = mean_{n−1} + δ/n, M2_n = M2_{n−1} + δ (x − mean_n).
+    const double x = values[c];
+    const double delta = x - s.mean[c];
+    s.mean[c] += delta / n;
+    s.m2[c] += delta * (x - s.mean[c]);
+  }
+  return true;
+}
+
+Film::Film(int width, int height, int splits) : width_(width), height_(height) {
+  if (splits != 1 && splits != 2 && splits != 4)
+    throw std::invalid_argument("Film: splits must be 1, 2 or 4");
+  for (int k = 0; k < splits; ++k) subBuffers_.push_back(SubBuffer::zeros(width, height));
+}
+
+void Film::store(int x, int y, const PixelAccumulator& pixel) {
+  for (size_t k = 0; k < subBuffers_.size(); ++k) {
+    const PixelAccumulator::Stats& s = pixel.stats(int(k));
+    SubBuffer& sub = subBuffers_[k];
+    const double n = s.count;
+    const auto write = [&](MeanVariance& q, size_t first, int count) {
+      float* mean = q.mean.pixel(x, y);
+      float* variance = q.varianceOfMean.pixel(x, y);
+      for (int c = 0; c < count; ++c) {
+        mean[c] = float(s.mean[first + size_t(c)]);
+        // Clamped so that a finite but huge sample cannot overflow the float output.
+        const double v = n >= 2 ? s.m2[first + size_t(c)] / (n * (n - 1)) : 0.0;
+        variance[c] = float(std::min(v, double(std::numeric_limits<float>::max())));
+      }
+    };
+    write(sub.color, 0, 3);
+    write(sub.albedo, 3, 3);
+    write(sub.normal, 6, 3);
+    write(sub.depth, 9, 1);
+    write(sub.visibility, 10, 1);
+    sub.sampleCount(x, y, 0) = float(s.count);
+  }
+}
+
+SampleBuffers Film::release() {
+  return SampleBuffers(std::move(subBuffers_));
+}
+
+}  // namespace chorus::render

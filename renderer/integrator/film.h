@@ -1,0 +1,65 @@
+#pragma once
+// The film: per pixel and per sub-buffer, the running mean and M2 (Welford 1962, in double) of
+// colour and every feature, and the number of samples kept. A pixel's samples are accumulated by
+// one task in sample order, so the result does not depend on the thread count. Samples with any
+// non-finite value are dropped (and counted), so NaN/Inf never reach the output.
+#include <array>
+#include <cstdint>
+
+#include "denoise/buffers/sample_buffers.h"
+#include "renderer/math/vec.h"
+
+namespace chorus::render {
+
+// What one camera path contributes to its pixel.
+struct PathSample {
+  Rgb L;       // radiance
+  Rgb albedo;  // features at the first non-specular vertex (see path_tracer.h)
+  Vec3f normal;
+  float depth = 0;
+  float visibility = 0;
+
+  bool isFinite() const;
+};
+
+inline constexpr int kMaxSplits = 4;
+inline constexpr int kPathSampleChannels = 11;  // colour 3, albedo 3, normal 3, depth, visibility
+
+// Welford accumulators of one pixel for up to kMaxSplits sub-buffers.
+class PixelAccumulator {
+ public:
+  // Adds a sample to sub-buffer k; returns false (and keeps nothing) when it is not finite.
+  bool add(int k, const PathSample& sample);
+
+  struct Stats {
+    uint32_t count = 0;
+    std::array<double, kPathSampleChannels> mean{}, m2{};
+  };
+  const Stats& stats(int k) const { return stats_[size_t(k)]; }
+
+ private:
+  std::array<Stats, kMaxSplits> stats_{};
+};
+
+class Film {
+ public:
+  // splits ∈ {1, 2, 4}.
+  Film(int width, int height, int splits);
+
+  // Writes a finished pixel: mean, variance of the mean = M2 / (n (n − 1)) (0 when n < 2) and
+  // the sample count of every sub-buffer. Distinct pixels may be stored concurrently.
+  void store(int x, int y, const PixelAccumulator& pixel);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int splits() const { return int(subBuffers_.size()); }
+
+  // The K independent sub-buffers (moves them out of the film).
+  SampleBuffers release();
+
+ private:
+  int width_, height_;
+  std::vector<SubBuffer> subBuffers_;
+};
+
+}  // namespace chorus::render

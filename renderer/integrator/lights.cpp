@@ -1,0 +1,194 @@
+#include "renderer/integrator/lights.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "renderer/sampling/warps.h"
+
+namespace chorus::render {
+namespace {
+
+// Mean emitted radiance of a material (its emissive texture averaged over the image).
+Rgb meanEmission(const MaterialDesc& m, const SceneData& data) {
+  if (m.emissiveTexture < 0) return m.emissive;
+  const ImageDesc& image = data.textures[size_t(m.emissiveTexture)].image();
+  return m.emissive *
+         Rgb(image.meanSrgbDecoded[0], image.meanSrgbDecoded[1], image.meanSrgbDecoded[2]);
+}
+
+float triangleArea(const MeshDesc& mesh, uint32_t primID) {
+  const uint32_t* idx = &mesh.indices[3 * size_t(primID)];
+  return 0.5f * length(cross(mesh.positions[idx[1]] - mesh.positions[idx[0]],
+                             mesh.positions[idx[2]] - mesh.positions[idx[0]]));
+}
+
+// glTF KHR_lights_punctual spot falloff: a smooth step between the outer and inner cone,
+// squared (the extension's recommended implementation).
+float spotAttenuation(const PunctualLightDesc& light, Vec3f wi) {
+  const float cosOuter = std::cos(light.outerConeAngle);
+  const float cosInner = std::cos(light.innerConeAngle);
+  const float scale = 1.0f / std::max(1e-3f, cosInner - cosOuter);
+  const float cd = dot(light.direction, -wi);
+  const float a = std::clamp((cd - cosOuter) * scale, 0.0f, 1.0f);
+  return a * a;
+}
+
+float punctualPower(const PunctualLightDesc& light, float sceneRadius) {
+  const float I = light.intensity * light.color.luminance();
+  switch (light.type) {
+    case PunctualLightType::Point:
+      return 4.0f * kPi * I;
+    case PunctualLightType::Spot: {
+      const float cosMean =
+          0.5f * (std::cos(light.innerConeAngle) + std::cos(light.outerConeAngle));
+      return 2.0f * kPi * I * (1.0f - cosMean);
+    }
+    case PunctualLightType::Directional:
+    default:
+      return kPi * sceneRadius * sceneRadius * I;
+  }
+}
+
+}  // namespace
+
+LightSet::LightSet(const Scene& scene) : scene_(&scene), environment_(scene.environment()) {
+  const SceneData& data = scene.data();
+  const float radius = std::max(data.bounds.radius(), 1e-6f);
+  std::vector<float> power;
+
+  for (size_t geomID = 0; geomID < data.meshes.size(); ++geomID) {
+    const SceneMesh& sm = data.meshes[geomID];
+    if (sm.firstAreaLight < 0) continue;
+    const MaterialDesc& m = data.materials[size_t(sm.mesh.material)].desc;
+    const Rgb meanLe = meanEmission(m, data);
+    const float sides = m.doubleSided ? 2.0f : 1.0f;
+    for (uint32_t primID = 0; primID < sm.mesh.triangleCount(); ++primID) {
+      const float area = triangleArea(sm.mesh, primID);
+      areaLights_.push_back({uint32_t(geomID), primID, area});
+      lights_.push_back({Kind::Area, uint32_t(areaLights_.size() - 1)});
+      power.push_back(kPi * sides * area * meanLe.luminance());
+    }
+  }
+  for (size_t i = 0; i < data.punctualLights.size(); ++i) {
+    lights_.push_back({Kind::Punctual, uint32_t(i)});
+    power.push_back(punctualPower(data.punctualLights[i], radius));
+  }
+  if (environment_.emits()) {
+    environmentIndex_ = int(lights_.size());
+    lights_.push_back({Kind::Environment, 0});
+    power.push_back(environment_.power(radius));
+  }
+
+  double total = 0;
+  for (float& p : power) {
+    if (!(p > 0) || !std::isfinite(p)) p = 0;
+    total += p;
+  }
+  if (!(total > 0)) {
+    lights_.clear();
+    environmentIndex_ = -1;
+    return;
+  }
+  choice_ = AliasTable(power);
+}
+
+std::optional<LightSample> LightSet::sample(Vec3f ref, float uChoice, Vec2f u) const {
+  if (lights_.empty()) return std::nullopt;
+  float pmf = 0;
+  const int index = choice_.sample(uChoice, &pmf);
+  if (!(pmf > 0)) return std::nullopt;
+  const LightRef light = lights_[size_t(index)];
+  std::optional<LightSample> s;
+  switch (light.kind) {
+    case Kind::Area:
+      s = sampleArea(areaLights_[light.index], ref, u);
+      break;
+    case Kind::Punctual:
+      s = samplePunctual(scene_->data().punctualLights[light.index], ref);
+      break;
+    case Kind::Environment:
+      if (const auto e = environment_.sample(u)) {
+        s = LightSample{};
+        s->Li = e->Le;
+        s->wi = e->wi;
+        s->pdf = e->pdfSolidAngle;
+        s->isInfinite = true;
+      }
+      break;
+  }
+  if (!s || !(s->pdf > 0) || s->Li.isBlack()) return std::nullopt;
+  s->pdf *= pmf;
+  return s;
+}
+
+std::optional<LightSample> LightSet::sampleArea(const AreaLight& light, Vec3f ref, Vec2f u) const {
+  if (!(light.area > 0)) return std::nullopt;
+  const Vec2f b = sampleUniformTriangle(u);
+  const MeshDesc& mesh = scene_->data().meshes[light.geomID].mesh;
+  const uint32_t* idx = &mesh.indices[3 * size_t(light.primID)];
+  const Vec3f p = mesh.positions[idx[0]] * b.x + mesh.positions[idx[1]] * b.y +
+                  mesh.positions[idx[2]] * (1 - b.x - b.y);
+  const Vec3f toLight = p - ref;
+  const float distanceSquared = lengthSquared(toLight);
+  if (!(distanceSquared > 0)) return std::nullopt;
+  const Vec3f wi = toLight / std::sqrt(distanceSquared);
+  // The same evaluation as a ray hitting the light (emission side, texture, normal).
+  Hit hit;
+  hit.geomID = light.geomID;
+  hit.primID = light.primID;
+  hit.u = b.y;
+  hit.v = 1 - b.x - b.y;
+  const SurfaceInteraction si = scene_->interaction(hit, wi);
+  const float cosLight = std::abs(dot(si.geometricNormal, wi));
+  if (!(cosLight > 0)) return std::nullopt;
+  LightSample s;
+  s.Li = scene_->emitted(si);
+  s.wi = wi;
+  s.pdf = distanceSquared / (cosLight * light.area);
+  s.pLight = si.position;
+  s.pLightError = si.positionError;
+  s.nLight = si.geometricNormal;
+  return s;
+}
+
+std::optional<LightSample> LightSet::samplePunctual(const PunctualLightDesc& light,
+                                                    Vec3f ref) const {
+  LightSample s;
+  s.isDelta = true;
+  s.pdf = 1.0f;
+  if (light.type == PunctualLightType::Directional) {
+    s.wi = -light.direction;
+    s.Li = light.color * light.intensity;
+    s.isInfinite = true;
+    return s;
+  }
+  const Vec3f toLight = light.position - ref;
+  const float distanceSquared = lengthSquared(toLight);
+  if (!(distanceSquared > 0)) return std::nullopt;
+  s.wi = toLight / std::sqrt(distanceSquared);
+  s.Li = light.color * (light.intensity / distanceSquared);
+  if (light.type == PunctualLightType::Spot) s.Li *= spotAttenuation(light, s.wi);
+  s.pLight = light.position;
+  return s;
+}
+
+float LightSet::pdfAreaLight(Vec3f ref, const SurfaceInteraction& lightPoint) const {
+  if (lights_.empty()) return 0.0f;
+  const SceneMesh& sm = scene_->data().meshes[lightPoint.geomID];
+  if (sm.firstAreaLight < 0) return 0.0f;
+  const size_t index = size_t(sm.firstAreaLight) + lightPoint.primID;
+  const AreaLight& light = areaLights_[index];
+  const Vec3f toLight = lightPoint.position - ref;
+  const float distanceSquared = lengthSquared(toLight);
+  const float cosLight =
+      std::abs(dot(lightPoint.geometricNormal, toLight)) / std::sqrt(distanceSquared);
+  if (!(cosLight > 0) || !(light.area > 0)) return 0.0f;
+  return choice_.pmf(int(index)) * distanceSquared / (cosLight * light.area);
+}
+
+float LightSet::pdfEnvironment(Vec3f direction) const {
+  if (environmentIndex_ < 0) return 0.0f;
+  return choice_.pmf(environmentIndex_) * environment_.pdfSolidAngle(direction);
+}
+
+}  // namespace chorus::render

@@ -1,0 +1,188 @@
+#include "renderer/integrator/path_tracer.h"
+
+#include <cmath>
+
+#include "renderer/integrator/bsdf.h"
+#include "renderer/integrator/ray_offset.h"
+
+namespace chorus::render {
+namespace {
+
+// Features of one path, fixed at the first non-specular vertex (see path_tracer.h).
+struct FeatureRecorder {
+  bool locked = false, tentative = false;
+  Rgb albedo;
+  Vec3f normal;
+  float depth = 0;
+
+  void record(Rgb a, Vec3f n, float d) {
+    albedo = a;
+    normal = n;
+    depth = d;
+    tentative = true;
+  }
+};
+
+// Beer–Lambert transmittance through `distance` of a KHR_materials_volume interior:
+// σ = −ln(attenuationColor) / attenuationDistance.
+Rgb volumeTransmittance(const MaterialDesc& m, float distance) {
+  if (!std::isfinite(m.attenuationDistance)) return Rgb(1.0f);
+  Rgb t;
+  for (int c = 0; c < 3; ++c) {
+    const float color = std::max(m.attenuationColor[c], 1e-30f);
+    t[c] = std::exp(std::log(color) * distance / m.attenuationDistance);
+  }
+  return t;
+}
+
+}  // namespace
+
+bool PathTracer::unoccluded(const SurfaceInteraction& si, Vec3f ng,
+                            const LightSample& light) const {
+  const Vec3f origin = offsetRayOrigin(si.position, si.positionError, ng, light.wi);
+  if (light.isInfinite)
+    return !scene_.occluded(origin, light.wi, std::numeric_limits<float>::infinity());
+  Vec3f target = light.pLight;
+  if (lengthSquared(light.nLight) > 0)
+    target = offsetRayOrigin(light.pLight, light.pLightError, light.nLight, -light.wi);
+  return !scene_.occluded(origin, target - origin, 1.0f - kShadowEpsilon);
+}
+
+PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& rays) const {
+  PathSample out;
+  FeatureRecorder features;
+  float visibility = 0;
+  Rgb L(0.0f), beta(1.0f);
+  float etaScale = 1.0f;  // radiance scaling by refraction, removed for roulette decisions
+  Ray ray = cameraRay;
+  bool previousDelta = true;  // the camera ray counts as a delta event: no MIS on its hit
+  float previousPdf = 0;
+  Vec3f previousPosition = cameraRay.origin;
+  float pathLength = 0;
+  int volumeMaterial = -1;  // the material whose interior the path is in, or −1
+
+  for (int depth = 0;; ++depth) {
+    // Sampler dimensions per bounce, in the documented order.
+    const float uLobe = sampler.get1D();
+    const Vec2f uDirection = sampler.get2D();
+    const float uLight = sampler.get1D();
+    const Vec2f uLightPoint = sampler.get2D();
+    const float uRoulette = sampler.get1D();
+
+    Hit hit;
+    ++rays;
+    if (!scene_.intersect(ray, &hit, depth == 0)) {
+      const Vec3f direction = normalize(ray.direction);
+      const Rgb Le = lights_.environment().Le(direction);
+      if (!Le.isBlack()) {
+        const float w =
+            previousDelta ? 1.0f : powerHeuristic(previousPdf, lights_.pdfEnvironment(direction));
+        L += beta * Le * w;
+      }
+      if (!features.locked) {
+        features.record(beta, Vec3f{}, 0.0f);
+        features.locked = true;
+        visibility = 1.0f;
+      }
+      break;
+    }
+
+    const SurfaceInteraction si = scene_.interaction(hit, ray.direction);
+    const float segment = hit.t * length(ray.direction);
+    pathLength += segment;
+    const Material& material = scene_.material(si.material);
+    if (volumeMaterial >= 0)
+      beta *= volumeTransmittance(scene_.material(volumeMaterial).desc, segment);
+
+    // Emission found by the previous BSDF sample (or seen directly).
+    const Rgb Le = scene_.emitted(si);
+    if (!Le.isBlack()) {
+      const float w = previousDelta
+                          ? 1.0f
+                          : powerHeuristic(previousPdf, lights_.pdfAreaLight(previousPosition, si));
+      L += beta * Le * w;
+    }
+
+    const Bsdf bsdf(scene_.materialPoint(si));
+    const bool transmissive = bsdf.hasTransmission();
+    const bool specular = bsdf.isPurelySpecular();
+    const Vec3f wo = -normalize(ray.direction);
+    // Opaque surfaces are shaded from the side the ray arrives on (both sides reflect);
+    // transmissive ones keep their outward frame so that wo.z < 0 means "from inside".
+    Vec3f ng = si.geometricNormal, ns = si.shadingNormal;
+    if (!transmissive && dot(wo, ng) < 0) ng = -ng, ns = -ns;
+    Frame frame = Frame::fromZX(ns, si.tangent);
+    Vec3f woLocal = frame.toLocal(wo);
+    if (!transmissive && woLocal.z < 1e-4f) {
+      // A shading normal that faces away from the viewer: shade with the geometric one.
+      frame = Frame::fromZX(ng, si.tangent);
+      woLocal = frame.toLocal(wo);
+    }
+
+    if (!features.locked)
+      features.record(beta * bsdf.albedo(), faceForward(frame.z, wo), pathLength);
+    if (depth >= settings_.maxDepth) break;
+
+    // Next-event estimation.
+    bool lightVisible = false;
+    if (!specular && !lights_.empty()) {
+      if (const auto ls = lights_.sample(si.position, uLight, uLightPoint)) {
+        const Vec3f wiLocal = frame.toLocal(ls->wi);
+        const bool sameSide = (dot(ls->wi, ng) > 0) == (dot(wo, ng) > 0);
+        if (transmissive || sameSide) {
+          const Rgb f = bsdf.f(woLocal, wiLocal) * std::abs(wiLocal.z);
+          if (!f.isBlack()) {
+            ++rays;
+            if (unoccluded(si, ng, *ls)) {
+              const float w =
+                  ls->isDelta ? 1.0f : powerHeuristic(ls->pdf, bsdf.pdf(woLocal, wiLocal));
+              L += beta * f * ls->Li * (w / ls->pdf);
+              lightVisible = true;
+            }
+          }
+        }
+      }
+    }
+    if (!features.locked && !specular) {
+      features.locked = true;
+      visibility = lightVisible ? 1.0f : 0.0f;
+    }
+
+    // Continue the path by sampling the BSDF.
+    const auto bs = bsdf.sample(woLocal, uLobe, uDirection);
+    if (!bs || !(bs->pdf > 0) || bs->f.isBlack()) break;
+    const Vec3f wi = frame.fromLocal(bs->wi);
+    // Reject directions whose side of the geometric surface contradicts the lobe (possible
+    // with shading normals): they would leak light through the surface.
+    const bool crosses = (dot(wi, ng) > 0) != (dot(wo, ng) > 0);
+    if (crosses != bs->isTransmission) break;
+    beta *= bs->f * (std::abs(bs->wi.z) / bs->pdf);
+    previousDelta = bs->isDelta;
+    previousPdf = bs->pdf;
+    previousPosition = si.position;
+
+    if (bs->isTransmission && material.desc.hasVolume) {
+      const bool entering = dot(wi, si.geometricNormal) < 0;
+      volumeMaterial = entering ? si.material : -1;
+      const float eta2 = material.desc.ior * material.desc.ior;
+      etaScale *= entering ? eta2 : 1.0f / eta2;
+    }
+    ray = {offsetRayOrigin(si.position, si.positionError, ng, wi), wi,
+           std::numeric_limits<float>::infinity()};
+
+    if (depth + 1 >= settings_.rouletteStartDepth) {
+      const float survive = std::min(1.0f, (beta * etaScale).maxComponent());
+      if (!(uRoulette < survive)) break;
+      beta = beta / survive;
+    }
+  }
+
+  out.L = L;
+  out.albedo = features.albedo;
+  out.normal = features.normal;
+  out.depth = features.depth;
+  out.visibility = features.locked ? visibility : 0.0f;
+  return out;
+}
+
+}  // namespace chorus::render

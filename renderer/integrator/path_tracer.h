@@ -1,0 +1,51 @@
+#pragma once
+// Unidirectional path tracing with next-event estimation. Area lights and the environment are
+// reached both by light sampling and by BSDF sampling, combined with the power heuristic
+// (Veach 1997, §9.2); punctual lights only by light sampling. Russian roulette from the third
+// bounce on, with the survival probability min(1, max throughput component) (radiance scaling
+// by refraction factored out). Shadow rays are blocked by every surface except alpha-test
+// cutouts: light through glass is found by BSDF sampling only.
+//
+// Features (recorded per sample, at the first vertex whose BSDF is not purely specular, so
+// mirror and glass chains are followed):
+//   albedo      Bsdf::albedo() times the throughput of the specular chain before the vertex
+//   normal      world-space shading normal, turned to face the incoming ray
+//   depth       distance travelled along the path from the camera to the vertex
+//   visibility  1 if the vertex's next-event estimate found its light unoccluded with a non-zero
+//               contribution, else 0 (the pixel mean is the fraction of unoccluded shadow rays)
+// Rays that escape before such a vertex: albedo = the chain's throughput (1 for camera rays:
+// white, so dividing by albedo leaves the background unchanged), normal = 0, depth = 0,
+// visibility = 1. Paths that end inside a specular chain (absorbed, roulette, maximum depth)
+// keep the last specular vertex's albedo, normal and depth, with visibility 0.
+#include <cstdint>
+
+#include "renderer/integrator/film.h"
+#include "renderer/integrator/lights.h"
+#include "renderer/sampling/sampler.h"
+#include "renderer/scene/scene.h"
+
+namespace chorus::render {
+
+struct PathTracerSettings {
+  int maxDepth = 8;            // maximum number of scattering events on a path
+  int rouletteStartDepth = 3;  // Russian roulette from this bounce on
+};
+
+class PathTracer {
+ public:
+  PathTracer(const Scene& scene, const LightSet& lights, PathTracerSettings settings)
+      : scene_(scene), lights_(lights), settings_(settings) {}
+
+  // One path from a camera ray. Consumes sampler dimensions in the order documented in
+  // renderer/sampling/sampler.h. `rays` counts every ray traced (camera, bounce and shadow).
+  PathSample trace(const Ray& cameraRay, Sampler& sampler, uint64_t& rays) const;
+
+ private:
+  bool unoccluded(const SurfaceInteraction& si, Vec3f ng, const LightSample& light) const;
+
+  const Scene& scene_;
+  const LightSet& lights_;
+  PathTracerSettings settings_;
+};
+
+}  // namespace chorus::render

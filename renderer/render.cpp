@@ -1,0 +1,115 @@
+#include "renderer/render.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <string>
+
+#include "denoise/util/error.h"
+#include "renderer/integrator/camera.h"
+#include "renderer/integrator/film.h"
+#include "renderer/integrator/lights.h"
+#include "renderer/integrator/path_tracer.h"
+#include "renderer/sampling/sampler.h"
+
+namespace chorus::render {
+namespace {
+
+constexpr int kTileSize = 16;
+
+void validate(const RenderOptions& o) {
+  if (o.spp < 1) throw Error("--spp must be at least 1 (got " + std::to_string(o.spp) + ")");
+  if (o.splits != 1 && o.splits != 2 && o.splits != 4)
+    throw Error("--splits must be 1, 2 or 4 (got " + std::to_string(o.splits) + ")");
+  if (o.width < 0 || o.height < 0) throw Error("--width and --height must be positive");
+  if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");
+  if (o.threads < 0) throw Error("--threads must be positive (0 = all cores)");
+}
+
+}  // namespace
+
+RenderResult render(const Scene& scene, const RenderOptions& options,
+                    const ProgressCallback& progress) {
+  validate(options);
+  const auto start = std::chrono::steady_clock::now();
+
+  // The camera's own aspect decides a missing dimension; the framing camera adapts to the image.
+  const CameraDesc* fileCamera = options.camera < int(scene.data().cameras.size())
+                                     ? &scene.data().cameras[size_t(std::max(0, options.camera))]
+                                     : nullptr;
+  const Resolution resolution =
+      chooseResolution(fileCamera ? *fileCamera : CameraDesc{}, options.width, options.height);
+  const Camera camera(
+      selectCamera(scene, options.camera, float(resolution.width) / float(resolution.height)),
+      resolution);
+  const LightSet lights(scene);
+  const PathTracer tracer(scene, lights, PathTracerSettings{options.maxDepth, 3});
+  Film film(resolution.width, resolution.height, options.splits);
+
+  const int tilesX = (resolution.width + kTileSize - 1) / kTileSize;
+  const int tilesY = (resolution.height + kTileSize - 1) / kTileSize;
+  const uint64_t samplesTotal =
+      uint64_t(resolution.width) * uint64_t(resolution.height) * uint64_t(options.spp);
+  std::atomic<uint64_t> rays{0}, dropped{0}, samplesDone{0};
+  std::mutex progressMutex;
+
+  const auto renderTile = [&](int tile) {
+    const int x0 = (tile % tilesX) * kTileSize, y0 = (tile / tilesX) * kTileSize;
+    const int x1 = std::min(x0 + kTileSize, resolution.width);
+    const int y1 = std::min(y0 + kTileSize, resolution.height);
+    Sampler sampler(options.seed);
+    uint64_t tileRays = 0, tileDropped = 0;
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        PixelAccumulator pixel;
+        for (int i = 0; i < options.spp; ++i) {
+          const int k = i % options.splits;
+          sampler.startPixelSample(x, y, uint32_t(i / options.splits), k);
+          const Vec2f offset = sampler.getPixel2D();
+          const Ray ray = camera.generateRay({float(x) + offset.x, float(y) + offset.y});
+          if (!pixel.add(k, tracer.trace(ray, sampler, tileRays))) ++tileDropped;
+        }
+        film.store(x, y, pixel);
+      }
+    }
+    rays += tileRays;
+    dropped += tileDropped;
+    const uint64_t done = samplesDone +=
+        uint64_t(x1 - x0) * uint64_t(y1 - y0) * uint64_t(options.spp);
+    if (progress) {
+      const std::lock_guard<std::mutex> lock(progressMutex);
+      progress({done, samplesTotal,
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()});
+    }
+  };
+
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, tilesX * tilesY, 1),
+        [&](const tbb::blocked_range<int>& range) {
+          for (int tile = range.begin(); tile < range.end(); ++tile) renderTile(tile);
+        },
+        tbb::simple_partitioner());
+  });
+
+  RenderResult result;
+  result.buffers = film.release();
+  RenderStats& s = result.stats;
+  s.width = resolution.width;
+  s.height = resolution.height;
+  s.spp = options.spp;
+  s.splits = options.splits;
+  s.renderSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  s.samples = samplesTotal;
+  s.rays = rays;
+  s.nanSamplesDropped = dropped;
+  s.triangles = scene.data().triangleCount;
+  return result;
+}
+
+}  // namespace chorus::render

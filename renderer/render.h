@@ -1,0 +1,63 @@
+#pragma once
+// The renderer's in-process entry point: a built Scene + options → SampleBuffers (K independent
+// sub-buffers of colour and features with their variances) and statistics.
+//
+//   SceneDesc desc = loadGltf("scene.gltf");                        // renderer/scene/gltf_loader.h
+//   Scene scene = buildScene(std::move(desc), EnvironmentDesc{});    // renderer/scene/scene.h
+//   RenderOptions options;  options.spp = 64;  options.splits = 4;
+//   RenderResult result = render(scene, options);
+//   result.buffers.input(BufferPart::HalfA) ...                      // denoise/buffers
+//
+// A Scene can be rendered any number of times (e.g. a sweep over spp); render() only reads it.
+// Determinism: the same scene, options.seed, spp, splits, resolution and camera give
+// bit-identical buffers for any thread count (each pixel is computed by one task, its samples in
+// order; sample i of a pixel goes to sub-buffer i mod K and uses that sub-buffer's own scramble).
+#include <cstdint>
+#include <functional>
+
+#include "denoise/buffers/sample_buffers.h"
+#include "renderer/scene/scene.h"
+
+namespace chorus::render {
+
+struct RenderOptions {
+  int width = 0, height = 0;  // 0: from the camera (see chooseResolution in camera.h)
+  int spp = 64;               // samples per pixel, over all sub-buffers
+  int splits = 1;             // K ∈ {1, 2, 4}
+  uint64_t seed = 0;
+  int threads = 0;   // 0: all cores
+  int maxDepth = 8;  // maximum number of scattering events per path
+  int camera = 0;    // index into the scene's cameras (0 with none: frame the bounds)
+};
+
+struct RenderStats {
+  int width = 0, height = 0, spp = 0, splits = 0;
+  double renderSeconds = 0;
+  uint64_t samples = 0;            // paths traced (width × height × spp)
+  uint64_t rays = 0;               // camera, bounce and shadow rays
+  uint64_t nanSamplesDropped = 0;  // samples with a non-finite value, not accumulated
+  size_t triangles = 0;
+  double samplesPerSecond() const {
+    return renderSeconds > 0 ? double(samples) / renderSeconds : 0;
+  }
+  double raysPerSecond() const { return renderSeconds > 0 ? double(rays) / renderSeconds : 0; }
+};
+
+struct RenderProgress {
+  uint64_t samplesDone = 0, samplesTotal = 0;
+  double elapsedSeconds = 0;
+  double fraction() const { return samplesTotal ? double(samplesDone) / double(samplesTotal) : 1; }
+};
+// Called from worker threads, one call at a time, after each finished tile.
+using ProgressCallback = std::function<void(const RenderProgress&)>;
+
+struct RenderResult {
+  SampleBuffers buffers;
+  RenderStats stats;
+};
+
+// Throws chorus::Error for invalid options (spp < 1, splits not 1/2/4, a missing camera, …).
+RenderResult render(const Scene& scene, const RenderOptions& options,
+                    const ProgressCallback& progress = {});
+
+}  // namespace chorus::render

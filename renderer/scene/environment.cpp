@@ -1,0 +1,99 @@
+#include "renderer/scene/environment.h"
+
+#include <stb_image.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <sstream>
+
+#include "denoise/image/exr_io.h"
+#include "denoise/util/error.h"
+
+namespace chorus::render {
+namespace {
+
+std::string lowerExtension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+Image readHdr(const std::filesystem::path& path) {
+  int width = 0, height = 0, channels = 0;
+  float* pixels = stbi_loadf(path.c_str(), &width, &height, &channels, 3);
+  if (!pixels)
+    throw fileError(path, std::string("cannot read HDR image: ") +
+                              (stbi_failure_reason() ? stbi_failure_reason() : "unknown error"));
+  Image image(width, height, 3);
+  std::copy(pixels, pixels + size_t(width) * size_t(height) * 3, image.data());
+  stbi_image_free(pixels);
+  return image;
+}
+
+Image readExrRgb(const std::filesystem::path& path) {
+  const std::vector<ExrLayer> layers = readExr(path);
+  const ExrLayer* layer = findLayer(layers, "");
+  if (!layer && layers.size() == 1) layer = &layers[0];
+  if (!layer) throw fileError(path, "has no default RGB layer to use as an environment");
+  const Image& image = layer->image;
+  if (image.channels() >= 3) return image.channelRange(0, 3);
+  Image rgb(image.width(), image.height(), 3);
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x)
+      for (int c = 0; c < 3; ++c) rgb(x, y, c) = image(x, y, 0);
+  return rgb;
+}
+
+}  // namespace
+
+Image loadEnvironmentImage(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw fileError(path, "no such file");
+  const std::string ext = lowerExtension(path);
+  Image image;
+  if (ext == ".exr") {
+    image = readExrRgb(path);
+  } else if (ext == ".hdr" || ext == ".pic") {
+    image = readHdr(path);
+  } else {
+    throw fileError(path, "environment maps must be Radiance .hdr or OpenEXR .exr files");
+  }
+  if (image.width() < 1 || image.height() < 1) throw fileError(path, "is an empty image");
+  for (float& v : image.values())
+    if (!(v > 0) || !std::isfinite(v)) v = 0.0f;
+  return image;
+}
+
+EnvironmentDesc environmentFromFile(const std::filesystem::path& path, float rotationDegrees,
+                                    float intensity) {
+  EnvironmentDesc e;
+  e.kind = EnvironmentDesc::Kind::Map;
+  e.map = std::make_shared<const Image>(loadEnvironmentImage(path));
+  e.source = path.string();
+  e.rotationDegrees = rotationDegrees;
+  e.intensity = intensity;
+  return e;
+}
+
+Rgb parseRgb(const std::string& text) {
+  std::vector<float> values;
+  std::stringstream in(text);
+  std::string part;
+  while (std::getline(in, part, ',')) {
+    try {
+      size_t used = 0;
+      const float v = std::stof(part, &used);
+      if (used != part.size() || !std::isfinite(v) || v < 0) throw std::invalid_argument(part);
+      values.push_back(v);
+    } catch (const std::exception&) {
+      throw Error("'" + text + "' is not a colour: expected R,G,B with non-negative numbers");
+    }
+  }
+  if (values.size() == 1) return Rgb(values[0]);
+  if (values.size() != 3)
+    throw Error("'" + text + "' is not a colour: expected R,G,B with non-negative numbers");
+  return {values[0], values[1], values[2]};
+}
+
+}  // namespace chorus::render

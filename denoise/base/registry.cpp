@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "denoise/base/atrous.h"
 #include "denoise/base/sbf.h"
 
 #include "denoise/util/error.h"
@@ -13,6 +14,9 @@ const std::vector<DenoiserEntry>& builtinDenoisers() {
   static const std::vector<DenoiserEntry> entries = {
       {"sbf", "SURE-based selection among feature-guided cross-bilateral filters (Li et al. 2012)",
        [](ParamMap& p) { return std::make_unique<Sbf>(SbfParams::fromParams(p)); }},
+      {"atrous",
+       "edge-avoiding à-trous wavelet filter, SVGF weights (Dammertz et al. 2010): fast preview",
+       [](ParamMap& p) { return std::make_unique<Atrous>(AtrousParams::fromParams(p)); }},
   };
   return entries;
 }

@@ -38,27 +38,31 @@ inline float fastExpNonPositive(float x) {
   return p * std::bit_cast<float>(biased << 23);
 }
 
+#if defined(__SSE2__)
+// Four lanes of exp(−e), bit-identical to fastExpNonPositive(−e) in each lane.
+inline __m128 fastExpNegatedSse(__m128 e) {
+  using namespace fast_exp_detail;
+  // −e·log2(e) equals (−e)·log2(e) exactly (sign symmetry), as in the scalar form.
+  __m128 t = _mm_mul_ps(e, _mm_set1_ps(-kLog2e));
+  t = _mm_max_ps(t, _mm_set1_ps(-127.0f));  // maxps returns the second operand for NaN
+  t = _mm_min_ps(t, _mm_setzero_ps());
+  const __m128 round = _mm_set1_ps(kRound);
+  const __m128 rounded = _mm_add_ps(t, round);
+  const __m128 n = _mm_sub_ps(rounded, round);
+  const __m128i biased = _mm_add_epi32(_mm_castps_si128(rounded),
+                                       _mm_set1_epi32(127 - std::bit_cast<int32_t>(kRound)));
+  const __m128 y = _mm_mul_ps(_mm_sub_ps(t, n), _mm_set1_ps(kLn2));
+  __m128 p = _mm_set1_ps(kTaylor[0]);
+  for (int k = 1; k < 7; ++k) p = _mm_add_ps(_mm_mul_ps(p, y), _mm_set1_ps(kTaylor[k]));
+  return _mm_mul_ps(p, _mm_castsi128_ps(_mm_slli_epi32(biased, 23)));
+}
+#endif
+
 // out[i] = exp(−e[i]) for i < count (e ≥ 0; see above for other inputs). out may alias e.
 inline void fastExpNegated(const float* e, float* out, int count) {
   int i = 0;
 #if defined(__SSE2__)
-  using namespace fast_exp_detail;
-  const __m128 log2e = _mm_set1_ps(-kLog2e), lo = _mm_set1_ps(-127.0f), hi = _mm_setzero_ps();
-  const __m128 round = _mm_set1_ps(kRound), ln2 = _mm_set1_ps(kLn2);
-  const __m128i bias = _mm_set1_epi32(127 - std::bit_cast<int32_t>(kRound));
-  for (; i + 4 <= count; i += 4) {
-    // −e·log2(e) equals (−e)·log2(e) exactly (sign symmetry), as in the scalar form.
-    __m128 t = _mm_mul_ps(_mm_loadu_ps(e + i), log2e);
-    t = _mm_max_ps(t, lo);  // maxps returns the second operand for NaN: the floor
-    t = _mm_min_ps(t, hi);
-    const __m128 rounded = _mm_add_ps(t, round);
-    const __m128 n = _mm_sub_ps(rounded, round);
-    const __m128i biased = _mm_add_epi32(_mm_castps_si128(rounded), bias);
-    const __m128 y = _mm_mul_ps(_mm_sub_ps(t, n), ln2);
-    __m128 p = _mm_set1_ps(kTaylor[0]);
-    for (int k = 1; k < 7; ++k) p = _mm_add_ps(_mm_mul_ps(p, y), _mm_set1_ps(kTaylor[k]));
-    _mm_storeu_ps(out + i, _mm_mul_ps(p, _mm_castsi128_ps(_mm_slli_epi32(biased, 23))));
-  }
+  for (; i + 4 <= count; i += 4) _mm_storeu_ps(out + i, fastExpNegatedSse(_mm_loadu_ps(e + i)));
 #endif
   for (; i < count; ++i) out[i] = fastExpNonPositive(-e[i]);
 }

@@ -1,0 +1,60 @@
+#pragma once
+// Edge-avoiding à-trous wavelet filter (Dammertz, Sewtz, Hanika, Lensch, HPG 2010) with the
+// edge-stopping weights of SVGF (Schied et al., HPG 2017, §4.3), without SVGF's temporal part;
+// values as in ../shared/docs/base-denoisers.md §6. The fast member, for previews.
+//
+// Iteration i = 0 … N−1 filters the previous result with the 5×5 B3-spline kernel
+// h = (1/16, 1/4, 3/8, 1/4, 1/16)² with taps 2^i pixels apart, weighted per tap q of pixel p by
+//   w_z = exp(−|z(p) − z(q)| / (σ_z |∇z(p)·(p − q)| + ε_z))
+//   w_n = max(0, n(p)·n(q))^σ_n
+//   w_l = exp(−|l(p) − l(q)| / (σ_l √(g3×3 ∗ Var_l)(p) + ε_l))
+// and propagates the luminance variance: Var'(p) = Σ h² w² Var(q) / (Σ h w)².
+// Our choices where the papers leave them open:
+//   - depth is divided by the largest finite depth; ∇z per axis is the one-sided difference of
+//     smaller magnitude (a central difference would open every depth edge); ε_z = 1e-3;
+//   - normals are normalised; a pixel without a normal (zero vector) does not constrain w_n;
+//   - luminance a = (0.2126, 0.7152, 0.0722); Var_l = (Σ_c a_c √V_c)² from the per-channel
+//     variances of the mean (channels are positively correlated; Σ a_c² V_c under-estimates);
+//   - optional albedo demodulation: colour and its variance divided by max(albedo, 1e-3) (and
+//     its square) before filtering, the result multiplied back after;
+//   - optional firefly clamp (preview only, biased): luminance limited to 10× its 3×3 median.
+#include <string>
+
+#include "denoise/base/base_denoiser.h"
+#include "denoise/base/param_map.h"
+
+namespace chorus {
+
+struct AtrousParams {
+  int iterations = 5;           // N: à-trous levels, tap spacing 2^i (5 → a 125-pixel footprint)
+  float sigmaZ = 1.0f;          // σ_z: depth tolerance in units of the depth gradient (SVGF)
+  float sigmaN = 128.0f;        // σ_n: exponent of the normal weight (SVGF)
+  float sigmaL = 4.0f;          // σ_l: luminance tolerance in noise standard deviations (SVGF)
+  bool demodulate = true;       // filter colour / albedo (measured: see README)
+  bool clampFireflies = false;  // clamp luminance to 10× the 3×3 median first (see README)
+
+  // Reads overrides: iterations, sigmaZ, sigmaN, sigmaL, demodulate, clampFireflies.
+  // Throws chorus::Error for a value out of range.
+  static AtrousParams fromParams(ParamMap& params);
+};
+
+// Which implementation of the inner kernel runs: the widest the CPU supports (AVX2 or SSE2),
+// or a narrower one. All give bit-identical results; tests compare them.
+enum class AtrousKernelPath { Widest, Sse2, Scalar };
+
+// Runs the filter on one buffer (colour and its variance, albedo, normal, depth).
+Image runAtrous(const SubBuffer& buffer, const AtrousParams& params,
+                AtrousKernelPath path = AtrousKernelPath::Widest);
+
+class Atrous : public BaseDenoiser {
+ public:
+  explicit Atrous(AtrousParams params = {}) : params_(params) {}
+  std::string name() const override { return "atrous"; }
+  DenoiserRequirements requirements() const override { return {.features = true, .halves = false}; }
+  Image run(const DenoiseInput& input) const override { return runAtrous(input.whole, params_); }
+
+ private:
+  AtrousParams params_;
+};
+
+}  // namespace chorus

@@ -1,0 +1,143 @@
+#pragma once
+// The inner kernel of one à-trous level (atrous.h), written once as templates over the lane
+// type (float_lanes.h). Included by atrous.cpp, which instantiates it for SSE2, and by
+// atrous_avx2.cpp, which instantiates it for AVX2 with that instruction set enabled (see there:
+// the includes below must already have been included before its target pragma). Everything
+// here except the plain structs has internal linkage, so that the two instruction-set versions
+// of the same template never merge at link time.
+#include <algorithm>
+#include <array>
+#include <cstddef>
+
+#include "denoise/util/float_lanes.h"
+
+namespace chorus {
+
+// Everything one à-trous level reads, as padded planes (index y·stride + x).
+struct AtrousLevelInputs {
+  int w = 0, h = 0, step = 1;
+  size_t stride = 0;
+  const float *z, *gx, *gy, *nx, *ny, *nz, *hasNormal;   // guide
+  const float *luminance, *inverseTolerance, *variance;  // this level's luminance statistics
+  const float* color[3];
+};
+
+// Filters one row of a level: (inputs, y, output colour planes, output variance plane).
+using AtrousRowFilter = void (*)(const AtrousLevelInputs&, int, float* const[3], float*);
+
+// The AVX2 row filters (atrous_avx2.cpp); nullptr where they were not compiled.
+AtrousRowFilter selectAtrousRowFilterAvx2(int squarings, bool unknownNormals);
+
+namespace {
+
+constexpr std::array<float, 5> kB3Spline = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};
+constexpr float kDepthEpsilon = 1e-3f;  // on depth / max depth
+
+// Filters F::kWidth consecutive pixels from (x, y) with the weights of the header. kBorder:
+// check every tap against the image (else the caller guarantees all taps are inside
+// horizontally). kSquarings: log2 σ_n, or −1 without the normal weight. kUnknownNormals: the
+// guide has pixels without a normal.
+template <class F, bool kBorder, int kSquarings, bool kUnknownNormals>
+void filterPixels(const AtrousLevelInputs& in, int x, int y, float* const outColor[3],
+                  float* outVariance) {
+  const size_t p = size_t(y) * in.stride + size_t(x);
+  const F zp = F::load(in.z + p), lp = F::load(in.luminance + p);
+  const F gx = F::load(in.gx + p), gy = F::load(in.gy + p);
+  const F tolerance = F::load(in.inverseTolerance + p);
+  const F one = F::broadcast(1.0f);
+  const F epsilon = F::broadcast(kDepthEpsilon);
+  F sum[3] = {F::broadcast(0), F::broadcast(0), F::broadcast(0)};
+  F weightSum = F::broadcast(0), varianceSum = F::broadcast(0);
+  for (int ty = -2; ty <= 2; ++ty) {
+    const int qy = y + ty * in.step;
+    if (qy < 0 || qy >= in.h) continue;
+    const F oy = F::broadcast(float(ty * in.step));
+    for (int tx = -2; tx <= 2; ++tx) {
+      const int qx = x + tx * in.step;
+      if (kBorder && (qx < 0 || qx >= in.w)) continue;
+      const size_t q = size_t(qy) * in.stride + size_t(qx);
+      const F ox = F::broadcast(float(tx * in.step));
+      const F kernel = F::broadcast(kB3Spline[size_t(tx + 2)] * kB3Spline[size_t(ty + 2)]);
+      // w_z w_l = exp(−|Δz| / (σ_z |∇z·δ| + ε_z) − |Δl| / (σ_l √Var + ε_l)); σ_z is in ∇z.
+      const F depthScale = abs(gx * ox + gy * oy) + epsilon;
+      const F e = abs(zp - F::load(in.z + q)) / depthScale +
+                  abs(lp - F::load(in.luminance + q)) * tolerance;
+      F w = kernel * expNegated(e);
+      if constexpr (kSquarings >= 0) {
+        // w_n = max(0, n_p·n_q)^(2^kSquarings).
+        const F dot = F::load(in.nx + p) * F::load(in.nx + q) +
+                      F::load(in.ny + p) * F::load(in.ny + q) +
+                      F::load(in.nz + p) * F::load(in.nz + q);
+        F wn = max0(dot);
+        for (int k = 0; k < kSquarings; ++k) wn = wn * wn;
+        if constexpr (kUnknownNormals) {
+          // A pixel without a normal does not constrain: w_n = 1 unless both are known.
+          const F both = F::load(in.hasNormal + p) * F::load(in.hasNormal + q);
+          wn = wn * both + (one - both);
+        }
+        w = w * wn;
+      }
+      weightSum = weightSum + w;
+      varianceSum = varianceSum + w * w * F::load(in.variance + q);
+      for (int c = 0; c < 3; ++c) sum[c] = sum[c] + w * F::load(in.color[c] + q);
+    }
+  }
+  // The centre tap always has weight h(0) > 0, so Σ h w > 0.
+  for (int c = 0; c < 3; ++c) (sum[c] / weightSum).store(outColor[c] + p);
+  (varianceSum / (weightSum * weightSum)).store(outVariance + p);
+}
+
+// Filters row y: borders one pixel at a time, the interior Wide::kWidth pixels at a time, and
+// what is left of it one pixel at a time.
+template <class Wide, int kSquarings, bool kUnknownNormals>
+void filterRow(const AtrousLevelInputs& in, int y, float* const outColor[3], float* outVariance) {
+  const int margin = 2 * in.step;  // pixels in [margin, w − margin) have all taps inside
+  int x = 0;
+  for (; x < std::min(margin, in.w); ++x)
+    filterPixels<Float1, true, kSquarings, kUnknownNormals>(in, x, y, outColor, outVariance);
+  for (; x + Wide::kWidth <= in.w - margin; x += Wide::kWidth)
+    filterPixels<Wide, false, kSquarings, kUnknownNormals>(in, x, y, outColor, outVariance);
+  for (; x < in.w - margin; ++x)
+    filterPixels<Float1, false, kSquarings, kUnknownNormals>(in, x, y, outColor, outVariance);
+  for (; x < in.w; ++x)
+    filterPixels<Float1, true, kSquarings, kUnknownNormals>(in, x, y, outColor, outVariance);
+}
+
+template <class Wide, int kSquarings>
+AtrousRowFilter rowFilterFor(bool unknownNormals) {
+  return unknownNormals ? &filterRow<Wide, kSquarings, true> : &filterRow<Wide, kSquarings, false>;
+}
+
+// The row filter for σ_n = 2^squarings (squarings = −1: no normal weight).
+template <class Wide>
+AtrousRowFilter selectRowFilter(int squarings, bool unknownNormals) {
+  switch (squarings) {
+    case -1:
+      return rowFilterFor<Wide, -1>(unknownNormals);
+    case 0:
+      return rowFilterFor<Wide, 0>(unknownNormals);
+    case 1:
+      return rowFilterFor<Wide, 1>(unknownNormals);
+    case 2:
+      return rowFilterFor<Wide, 2>(unknownNormals);
+    case 3:
+      return rowFilterFor<Wide, 3>(unknownNormals);
+    case 4:
+      return rowFilterFor<Wide, 4>(unknownNormals);
+    case 5:
+      return rowFilterFor<Wide, 5>(unknownNormals);
+    case 6:
+      return rowFilterFor<Wide, 6>(unknownNormals);
+    case 7:
+      return rowFilterFor<Wide, 7>(unknownNormals);
+    case 8:
+      return rowFilterFor<Wide, 8>(unknownNormals);
+    case 9:
+      return rowFilterFor<Wide, 9>(unknownNormals);
+    default:
+      return rowFilterFor<Wide, 10>(unknownNormals);
+  }
+}
+
+}  // namespace
+}  // namespace chorus

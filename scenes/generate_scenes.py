@@ -314,11 +314,11 @@ def cornell_box(directory):
     white = lambertian(gltf, "white", CORNELL_WHITE)
     red = lambertian(gltf, "red", CORNELL_RED)
     green = lambertian(gltf, "green", CORNELL_GREEN)
-    # Radiance = emissiveFactor × emissive_strength: (32, 27, 20) W/(m² sr) per RGB unit; with
-    # the 0.0137 m² light this lights the white walls to ~0.5 (exposure 0).
+    # Radiance = emissiveFactor × emissive_strength: (64, 54, 40) W/(m² sr); with
+    # the 0.0137 m² light this lights the back wall to ~0.35 and the red wall to ~0.8 (exposure 0).
     light = gltf.material("light", (0.0, 0.0, 0.0), 0.0, 1.0,
                           {"KHR_materials_specular": {"specularFactor": 0.0},
-                           "KHR_materials_emissive_strength": {"emissiveStrength": 32.0}},
+                           "KHR_materials_emissive_strength": {"emissiveStrength": 64.0}},
                           emissiveFactor=[1.0, 0.85, 0.62])
 
     def pts(*corners):
@@ -409,7 +409,7 @@ def glass_and_metal(directory):
     gold = gltf.material("smooth gold", (1.0, 0.78, 0.34), 1.0, 0.0)
     copper = gltf.material("rough copper", (0.95, 0.64, 0.54), 1.0, 0.35)
     light = gltf.material("small light", (0.0, 0.0, 0.0), 0.0, 1.0,
-                          {"KHR_materials_emissive_strength": {"emissiveStrength": 300.0}},
+                          {"KHR_materials_emissive_strength": {"emissiveStrength": 1000.0}},
                           emissiveFactor=[1.0, 0.95, 0.9])
 
     floor = Mesh()
@@ -517,9 +517,9 @@ def punctual_lights(directory):
 
     # KHR_lights_punctual: intensity in candela; lights shine down their node's −z.
     gltf.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
-        {"name": "spot", "type": "spot", "color": [1.0, 0.97, 0.9], "intensity": 40.0,
+        {"name": "spot", "type": "spot", "color": [1.0, 0.97, 0.9], "intensity": 50.0,
          "spot": {"innerConeAngle": 0.25, "outerConeAngle": 0.45}},
-        {"name": "fill", "type": "point", "color": [1.0, 0.8, 0.6], "intensity": 3.0},
+        {"name": "fill", "type": "point", "color": [1.0, 0.8, 0.6], "intensity": 5.0},
     ]}}
     gltf.extensions.add("KHR_lights_punctual")
     spot_position = [-1.0, 2.5, 1.0]

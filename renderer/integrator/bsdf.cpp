@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "renderer/integrator/fresnel.h"
-#include "renderer/integrator/specular_albedo.h"
 #include "renderer/sampling/warps.h"
 
 namespace chorus::render {
@@ -54,6 +53,16 @@ struct Bsdf::LobeWeights {
   bool any() const { return diffuse + metal + interface > 0; }
 };
 
+// What every evaluation for one wo shares: wo in the canonical frame (wo.z > 0; a solid seen
+// from inside is mirrored and flagged), the layer albedo at wo, Smith Λ(wo) and the lobe weights.
+struct Bsdf::Context {
+  Vec3f wo;
+  bool flip = false, inside = false;
+  float layerAlbedoO = 0;
+  float lambdaO = 0;
+  LobeWeights weights;
+};
+
 Bsdf::Bsdf(const MaterialPoint& material) : m_(material) {
   m_.baseColor = clamp01(material.baseColor);
   m_.metallic = clamp01(material.metallic);
@@ -67,15 +76,19 @@ Bsdf::Bsdf(const MaterialPoint& material) : m_(material) {
   eta_ = m_.ior;
   smooth_ = m_.roughness < kDeltaRoughness;
   ggx_ = GgxDistribution::fromRoughness(m_.roughness);
-  solidTransmission_ = !m_.thinWalled && hasTransmission();
+  transmits_ = (1.0f - m_.metallic) * m_.transmission > 0 && m_.baseColor.maxComponent() > 0;
+  solidTransmission_ = !m_.thinWalled && transmits_;
 
   // KHR_materials_specular: f0 = min(f0(ior) · specularColor, 1) · specular, f90 = specular.
   const float f0Ior = f0FromIor(eta_);
   f0_ = {std::min(f0Ior * m_.specularColor.r, 1.0f), std::min(f0Ior * m_.specularColor.g, 1.0f),
          std::min(f0Ior * m_.specularColor.b, 1.0f)};
   f0Max_ = f0_.maxComponent();
-  const SpecularAlbedoTerms average =
-      smooth_ ? kSmoothLayerAverage : specularAlbedoAverage(m_.roughness);
+  SpecularAlbedoTerms average = kSmoothLayerAverage;
+  if (!smooth_) {
+    layerAlbedoRow_ = SpecularAlbedoRow(m_.roughness);
+    average = layerAlbedoRow_.average();
+  }
   averageLayerAlbedo_ = m_.specular * average.albedo(f0Max_, 1.0f);
   averageLayerAlbedoRgb_ =
       Rgb(average.albedo(f0_.r, 1.0f), average.albedo(f0_.g, 1.0f), average.albedo(f0_.b, 1.0f)) *
@@ -93,8 +106,9 @@ Rgb Bsdf::dielectricFresnel(float cosTheta, bool inside, bool* transmits) const 
 }
 
 float Bsdf::layerAlbedo(float cosTheta) const {
+  if (m_.specular == 0) return 0;
   const SpecularAlbedoTerms terms =
-      smooth_ ? smoothLayerTerms(cosTheta) : specularAlbedo(cosTheta, m_.roughness);
+      smooth_ ? smoothLayerTerms(cosTheta) : layerAlbedoRow_.at(cosTheta);
   return std::min(1.0f, m_.specular * terms.albedo(f0Max_, 1.0f));
 }
 
@@ -108,18 +122,29 @@ float Bsdf::reflectTransmitChoice(const Rgb& fresnel, bool transmits) const {
   return reflect / (reflect + transmit);
 }
 
-Bsdf::LobeWeights Bsdf::lobeWeights(Vec3f wo, bool inside) const {
+Bsdf::Context Bsdf::context(Vec3f wo) const {
+  Context c;
+  c.flip = wo.z < 0;
+  c.inside = c.flip && solidTransmission_;
+  c.wo = c.flip ? mirrorZ(wo) : wo;
+  if (!c.inside) c.layerAlbedoO = layerAlbedo(c.wo.z);
+  if (!smooth_) c.lambdaO = ggx_.lambda(c.wo);
+  c.weights = lobeWeights(c);
+  return c;
+}
+
+Bsdf::LobeWeights Bsdf::lobeWeights(const Context& c) const {
   LobeWeights w;
   const float dielectric = 1.0f - m_.metallic;
   const float baseAverage = m_.baseColor.average();
-  if (!inside) {
+  if (!c.inside) {
     if (1.0f - averageLayerAlbedo_ > kMinBaseEnergy)
-      w.diffuse = dielectric * (1.0f - m_.transmission) * baseAverage * (1.0f - layerAlbedo(wo.z));
-    w.metal = m_.metallic * schlickFresnel(m_.baseColor, 1.0f, wo.z).average();
+      w.diffuse = dielectric * (1.0f - m_.transmission) * baseAverage * (1.0f - c.layerAlbedoO);
+    w.metal = m_.metallic * schlickFresnel(m_.baseColor, 1.0f, c.wo.z).average();
     if (!smooth_) w.metal = std::max(w.metal, m_.metallic * kMinRoughLobeWeight);
   }
   bool transmits;
-  const Rgb fresnel = dielectricFresnel(wo.z, inside, &transmits);
+  const Rgb fresnel = dielectricFresnel(c.wo.z, c.inside, &transmits);
   float transmit = transmits ? m_.transmission * baseAverage * (1.0f - fresnel.maxComponent()) : 0;
   if (!smooth_) transmit = std::max(transmit, m_.transmission * baseAverage * kMinRoughLobeWeight);
   w.interface = dielectric * (fresnel.average() + transmit);
@@ -133,36 +158,49 @@ Bsdf::LobeWeights Bsdf::lobeWeights(Vec3f wo, bool inside) const {
 }
 
 // Albedo-scaled Lambertian base (see bsdf.h): reciprocal, and ∫ f cos = ρ (1 − E(μo)).
-Rgb Bsdf::diffuseF(Vec3f wo, Vec3f wi) const {
+Rgb Bsdf::diffuseF(float layerAlbedoO, float cosThetaI) const {
   const float baseEnergy = 1.0f - averageLayerAlbedo_;
   if (!(baseEnergy > kMinBaseEnergy)) return {};
   const float weight = (1.0f - m_.metallic) * (1.0f - m_.transmission);
   if (weight == 0) return {};
   if (m_.specular == 0) return m_.baseColor * (weight * kInvPi);  // exactly Lambertian
   const float scale =
-      (1.0f - layerAlbedo(wo.z)) * (1.0f - layerAlbedo(wi.z)) / baseEnergy * weight * kInvPi;
+      (1.0f - layerAlbedoO) * (1.0f - layerAlbedo(cosThetaI)) / baseEnergy * weight * kInvPi;
   return m_.baseColor * scale;
 }
 
-// f for wo.z > 0; `inside` means wo is inside a solid transmissive object.
-Rgb Bsdf::fCanonical(Vec3f wo, Vec3f wi, bool inside) const {
+// f and pdf of the non-delta lobes for a canonical wo (c.wo.z > 0) and wi in the same frame.
+BsdfEval Bsdf::evalCanonical(const Context& c, Vec3f wi) const {
+  const Vec3f wo = c.wo;
+  const LobeWeights& w = c.weights;
   const float dielectric = 1.0f - m_.metallic;
-  Rgb f;
+  BsdfEval e;
   if (wi.z > 0) {
-    if (!inside) f += diffuseF(wo, wi);
-    if (smooth_) return f;
+    if (!c.inside) {
+      e.f += diffuseF(c.layerAlbedoO, wi.z);
+      e.pdf += w.diffuse * cosineHemispherePdfSolidAngle(wi.z);
+    }
+    if (smooth_) return e;
     const Vec3f h = normalize(wo + wi);
     const float cosOH = dot(wo, h);
-    const float microfacet = ggx_.D(h) * ggx_.G(wo, wi) / (4.0f * wo.z * wi.z);
-    if (!inside && m_.metallic > 0)
-      f += schlickFresnel(m_.baseColor, 1.0f, cosOH) * (m_.metallic * microfacet);
+    const float D = ggx_.D(h);
+    const float microfacet = D / ((1.0f + c.lambdaO + ggx_.lambda(wi)) * 4.0f * wo.z * wi.z);
+    // Visible-normal pdf / (4 wo·h) = G1(wo) D / (4 wo.z) (Heitz 2018, eq. 17 with the
+    // reflection Jacobian).
+    const float reflectPdf = D / ((1.0f + c.lambdaO) * 4.0f * wo.z);
+    if (!c.inside && m_.metallic > 0) {
+      e.f += schlickFresnel(m_.baseColor, 1.0f, cosOH) * (m_.metallic * microfacet);
+      e.pdf += w.metal * reflectPdf;
+    }
     if (dielectric > 0) {
       bool transmits;
-      f += dielectricFresnel(cosOH, inside, &transmits) * (dielectric * microfacet);
+      const Rgb fresnel = dielectricFresnel(cosOH, c.inside, &transmits);
+      e.f += fresnel * (dielectric * microfacet);
+      e.pdf += w.interface * reflectTransmitChoice(fresnel, transmits) * reflectPdf;
     }
-    return f;
+    return e;
   }
-  if (wi.z == 0 || smooth_ || !hasTransmission()) return f;
+  if (smooth_ || !transmits_) return e;
 
   const float weight = dielectric * m_.transmission;
   if (!solidTransmission_) {
@@ -171,99 +209,67 @@ Rgb Bsdf::fCanonical(Vec3f wo, Vec3f wi, bool inside) const {
     const Vec3f h = normalize(wo + wr);
     bool transmits;
     const Rgb fresnel = dielectricFresnel(dot(wo, h), false, &transmits);
-    const float microfacet = ggx_.D(h) * ggx_.G(wo, wr) / (4.0f * wo.z * wr.z);
-    return m_.baseColor * (weight * (1.0f - fresnel.maxComponent()) * microfacet);
+    const float D = ggx_.D(h);
+    const float microfacet = D / ((1.0f + c.lambdaO + ggx_.lambda(wr)) * 4.0f * wo.z * wr.z);
+    e.f = m_.baseColor * (weight * (1.0f - fresnel.maxComponent()) * microfacet);
+    e.pdf = w.interface * (1.0f - reflectTransmitChoice(fresnel, transmits)) * D /
+            ((1.0f + c.lambdaO) * 4.0f * wo.z);
+    return e;
   }
   // Walter et al. 2007, eq. 21, with the radiance scaling 1/η² (η = n_wi / n_wo):
   // f = |wi·h| |wo·h| / (|wi.z| wo.z) · D G (1 − F) / (wo·h + η wi·h)².
-  const float eta = inside ? 1.0f / eta_ : eta_;
+  const float eta = c.inside ? 1.0f / eta_ : eta_;
   const Vec3f halfway = wo + wi * eta;
-  if (!(lengthSquared(halfway) > 1e-12f)) return f;
+  if (!(lengthSquared(halfway) > 1e-12f)) return e;
   const Vec3f h = faceForward(normalize(halfway), Vec3f(0, 0, 1));
   const float cosOH = dot(wo, h), cosIH = dot(wi, h);
-  if (cosOH <= 0 || cosIH >= 0) return f;
+  if (cosOH <= 0 || cosIH >= 0) return e;
   bool transmits;
-  const Rgb fresnel = dielectricFresnel(cosOH, inside, &transmits);
-  if (!transmits) return f;
+  const Rgb fresnel = dielectricFresnel(cosOH, c.inside, &transmits);
+  if (!transmits) return e;
   const float denom = cosOH + eta * cosIH;
-  const float value =
-      ggx_.D(h) * ggx_.G(wo, wi) * (-cosIH) * cosOH / (wo.z * -wi.z * denom * denom);
-  return m_.baseColor * (weight * (1.0f - fresnel.maxComponent()) * value);
+  const float D = ggx_.D(h);
+  const float G = 1.0f / (1.0f + c.lambdaO + ggx_.lambda(wi));
+  const float value = D * G * (-cosIH) * cosOH / (wo.z * -wi.z * denom * denom);
+  e.f = m_.baseColor * (weight * (1.0f - fresnel.maxComponent()) * value);
+  // Visible-normal pdf times dωh/dωi = η² |wi·h| / (wo·h + η wi·h)² (Walter et al. 2007, eq. 17).
+  const float visibleNormalPdf = cosOH * D / ((1.0f + c.lambdaO) * wo.z);
+  const float jacobian = eta * eta * (-cosIH) / (denom * denom);
+  e.pdf = w.interface * (1.0f - reflectTransmitChoice(fresnel, transmits)) * visibleNormalPdf *
+          jacobian;
+  return e;
 }
 
-float Bsdf::pdfCanonical(Vec3f wo, Vec3f wi, bool inside, const LobeWeights& w) const {
-  float pdf = 0;
-  if (wi.z > 0) {
-    if (w.diffuse > 0) pdf += w.diffuse * cosineHemispherePdfSolidAngle(wi.z);
-    if (smooth_ || (w.metal == 0 && w.interface == 0)) return pdf;
-    const Vec3f h = normalize(wo + wi);
-    const float cosOH = dot(wo, h);
-    const float reflectPdf = ggx_.visibleNormalPdf(wo, h) / (4.0f * cosOH);
-    pdf += w.metal * reflectPdf;
-    if (w.interface > 0) {
-      bool transmits;
-      const Rgb fresnel = dielectricFresnel(cosOH, inside, &transmits);
-      pdf += w.interface * reflectTransmitChoice(fresnel, transmits) * reflectPdf;
-    }
-    return pdf;
-  }
-  if (wi.z == 0 || smooth_ || w.interface == 0 || !hasTransmission()) return pdf;
-
-  if (!solidTransmission_) {
-    const Vec3f h = normalize(wo + mirrorZ(wi));
-    const float cosOH = dot(wo, h);
-    bool transmits;
-    const Rgb fresnel = dielectricFresnel(cosOH, false, &transmits);
-    const float transmitChoice = 1.0f - reflectTransmitChoice(fresnel, transmits);
-    return w.interface * transmitChoice * ggx_.visibleNormalPdf(wo, h) / (4.0f * cosOH);
-  }
-  const float eta = inside ? 1.0f / eta_ : eta_;
-  const Vec3f halfway = wo + wi * eta;
-  if (!(lengthSquared(halfway) > 1e-12f)) return pdf;
-  const Vec3f h = faceForward(normalize(halfway), Vec3f(0, 0, 1));
-  const float cosOH = dot(wo, h), cosIH = dot(wi, h);
-  if (cosOH <= 0 || cosIH >= 0) return pdf;
-  bool transmits;
-  const Rgb fresnel = dielectricFresnel(cosOH, inside, &transmits);
-  if (!transmits) return pdf;
-  // dωh/dωi = η² |wi·h| / (wo·h + η wi·h)² (Walter et al. 2007, eq. 17).
-  const float denom = cosOH + eta * cosIH;
-  const float jacobian = eta * eta * (-cosIH) / (denom * denom);
-  const float transmitChoice = 1.0f - reflectTransmitChoice(fresnel, transmits);
-  return w.interface * transmitChoice * ggx_.visibleNormalPdf(wo, h) * jacobian;
+BsdfEval Bsdf::evaluate(Vec3f wo, Vec3f wi) const {
+  if (!grazingSafe(wo) || !grazingSafe(wi)) return {};
+  const Context c = context(wo);
+  return evalCanonical(c, c.flip ? mirrorZ(wi) : wi);
 }
 
 Rgb Bsdf::f(Vec3f wo, Vec3f wi) const {
-  if (!grazingSafe(wo) || !grazingSafe(wi)) return {};
-  const bool flip = wo.z < 0;
-  const bool inside = flip && solidTransmission_;
-  return fCanonical(flip ? mirrorZ(wo) : wo, flip ? mirrorZ(wi) : wi, inside);
+  return evaluate(wo, wi).f;
 }
 
 float Bsdf::pdf(Vec3f wo, Vec3f wi) const {
-  if (!grazingSafe(wo) || !grazingSafe(wi)) return 0;
-  const bool flip = wo.z < 0;
-  const bool inside = flip && solidTransmission_;
-  const Vec3f o = flip ? mirrorZ(wo) : wo;
-  return pdfCanonical(o, flip ? mirrorZ(wi) : wi, inside, lobeWeights(o, inside));
+  return evaluate(wo, wi).pdf;
 }
 
 std::optional<BsdfSample> Bsdf::sample(Vec3f woAsGiven, float uLobe, Vec2f u) const {
   if (!grazingSafe(woAsGiven) || !finiteInputs(woAsGiven, uLobe, u)) return std::nullopt;
-  const bool flip = woAsGiven.z < 0;
-  const bool inside = flip && solidTransmission_;
-  const Vec3f wo = flip ? mirrorZ(woAsGiven) : woAsGiven;
-  const LobeWeights w = lobeWeights(wo, inside);
+  const Context c = context(woAsGiven);
+  const Vec3f wo = c.wo;
+  const LobeWeights& w = c.weights;
   if (!w.any()) return std::nullopt;
   const auto finish = [&](BsdfSample s) -> std::optional<BsdfSample> {
     if (!(s.pdf > 0) || !s.f.isFinite() || !isFinite(s.wi)) return std::nullopt;
     s.isTransmission = s.wi.z < 0;
-    if (flip) s.wi = mirrorZ(s.wi);
+    if (c.flip) s.wi = mirrorZ(s.wi);
     return s;
   };
   const auto nonDelta = [&](Vec3f wi) -> std::optional<BsdfSample> {
     if (!grazingSafe(wi)) return std::nullopt;
-    return finish({fCanonical(wo, wi, inside), wi, pdfCanonical(wo, wi, inside, w), false, false});
+    const BsdfEval e = evalCanonical(c, wi);
+    return finish({e.f, wi, e.pdf, false, false});
   };
 
   // Diffuse: cosine-weighted hemisphere.
@@ -286,11 +292,11 @@ std::optional<BsdfSample> Bsdf::sample(Vec3f woAsGiven, float uLobe, Vec2f u) co
   const float uChoice =
       std::clamp((uLobe - w.diffuse - w.metal) / w.interface, 0.0f, 0x1.fffffep-1f);
   const float dielectric = 1.0f - m_.metallic;
-  const float eta = inside ? 1.0f / eta_ : eta_;
+  const float eta = c.inside ? 1.0f / eta_ : eta_;
   const Vec3f h = smooth_ ? Vec3f(0, 0, 1) : ggx_.sampleVisibleNormal(wo, u);
   const float cosOH = dot(wo, h);
   bool transmits;
-  const Rgb fresnel = dielectricFresnel(cosOH, inside, &transmits);
+  const Rgb fresnel = dielectricFresnel(cosOH, c.inside, &transmits);
   const float reflectChoice = reflectTransmitChoice(fresnel, transmits);
   const bool reflection = uChoice < reflectChoice;
 
@@ -322,7 +328,7 @@ bool Bsdf::isPurelySpecular() const {
 }
 
 bool Bsdf::hasTransmission() const {
-  return (1.0f - m_.metallic) * m_.transmission > 0 && m_.baseColor.maxComponent() > 0;
+  return transmits_;
 }
 
 Rgb Bsdf::albedo() const {

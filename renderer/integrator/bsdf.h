@@ -30,6 +30,7 @@
 #include <optional>
 
 #include "renderer/integrator/microfacet.h"
+#include "renderer/integrator/specular_albedo.h"
 #include "renderer/math/vec.h"
 
 namespace chorus::render {
@@ -58,11 +59,18 @@ struct BsdfSample {
   bool isTransmission = false;  // wi is on the other side of the surface than wo
 };
 
+// f and pdf for one pair of directions, computed together (cheaper than f() then pdf()).
+struct BsdfEval {
+  Rgb f;
+  float pdf = 0;
+};
+
 class Bsdf {
  public:
   explicit Bsdf(const MaterialPoint& material);
 
   Rgb f(Vec3f wo, Vec3f wi) const;
+  BsdfEval evaluate(Vec3f wo, Vec3f wi) const;  // {f(wo, wi), pdf(wo, wi)}
   // uLobe picks the lobe, u samples its direction. Returns nullopt when no direction results
   // (e.g. a microfacet normal that reflects below the surface).
   std::optional<BsdfSample> sample(Vec3f wo, float uLobe, Vec2f u) const;
@@ -80,17 +88,20 @@ class Bsdf {
 
  private:
   struct LobeWeights;
-  LobeWeights lobeWeights(Vec3f wo, bool inside) const;
+  struct Context;
+  Context context(Vec3f wo) const;
+  LobeWeights lobeWeights(const Context& c) const;
   Rgb dielectricFresnel(float cosTheta, bool inside, bool* transmits) const;
   float layerAlbedo(float cosTheta) const;  // E(μ) of the specular layer, max over channels
-  Rgb diffuseF(Vec3f wo, Vec3f wi) const;
-  Rgb fCanonical(Vec3f wo, Vec3f wi, bool inside) const;
-  float pdfCanonical(Vec3f wo, Vec3f wi, bool inside, const LobeWeights& weights) const;
+  Rgb diffuseF(float layerAlbedoO, float cosThetaI) const;
+  BsdfEval evalCanonical(const Context& c, Vec3f wi) const;
   float reflectTransmitChoice(const Rgb& fresnel, bool transmits) const;
 
   MaterialPoint m_;  // clamped to valid ranges
   GgxDistribution ggx_{1.0f};
+  SpecularAlbedoRow layerAlbedoRow_;  // rough only
   bool smooth_ = false;
+  bool transmits_ = false;          // hasTransmission()
   bool solidTransmission_ = false;  // refracts into a closed volume (wo.z < 0 is inside)
   float eta_ = 1.5f;                // IOR used by the interface (clamped away from 1)
   Rgb f0_;                          // dielectric normal reflectance per channel, before specular

@@ -103,22 +103,28 @@ SpecularAlbedoTerms lerp(SpecularAlbedoTerms a, SpecularAlbedoTerms b, float w) 
 
 }  // namespace
 
-SpecularAlbedoTerms specularAlbedo(float cosTheta, float roughness) {
+SpecularAlbedoRow::SpecularAlbedoRow(float roughness) {
   const Table& t = table();
-  int i, j;
-  float wi, wj;
+  int j;
+  gridPosition(std::sqrt(std::clamp(roughness, 0.0f, 1.0f)), kRoughnessCount, &j, &weight_);
+  lower_ = &t.directional[size_t(j * kCosineCount)];
+  upper_ = &t.directional[size_t((j + 1) * kCosineCount)];
+  average_ = lerp(t.average[size_t(j)], t.average[size_t(j + 1)], weight_);
+}
+
+SpecularAlbedoTerms SpecularAlbedoRow::at(float cosTheta) const {
+  int i;
+  float wi;
   gridPosition(std::sqrt(std::clamp(cosTheta, 0.0f, 1.0f)), kCosineCount, &i, &wi);
-  gridPosition(std::sqrt(std::clamp(roughness, 0.0f, 1.0f)), kRoughnessCount, &j, &wj);
-  const auto at = [&](int jj, int ii) { return t.directional[size_t(jj * kCosineCount + ii)]; };
-  return lerp(lerp(at(j, i), at(j, i + 1), wi), lerp(at(j + 1, i), at(j + 1, i + 1), wi), wj);
+  return lerp(lerp(lower_[i], lower_[i + 1], wi), lerp(upper_[i], upper_[i + 1], wi), weight_);
+}
+
+SpecularAlbedoTerms specularAlbedo(float cosTheta, float roughness) {
+  return SpecularAlbedoRow(roughness).at(cosTheta);
 }
 
 SpecularAlbedoTerms specularAlbedoAverage(float roughness) {
-  const Table& t = table();
-  int j;
-  float wj;
-  gridPosition(std::sqrt(std::clamp(roughness, 0.0f, 1.0f)), kRoughnessCount, &j, &wj);
-  return lerp(t.average[size_t(j)], t.average[size_t(j + 1)], wj);
+  return SpecularAlbedoRow(roughness).average();
 }
 
 }  // namespace chorus::render

@@ -23,4 +23,20 @@ SpecularAlbedoTerms specularAlbedo(float cosTheta, float roughness);
 // The cosine-weighted hemispherical average 2 ∫ E(μ) μ dμ.
 SpecularAlbedoTerms specularAlbedoAverage(float roughness);
 
+// The table at one roughness, for repeated lookups at different cosines (a BSDF keeps one).
+// Default-constructed it is unusable; construct it with a roughness.
+class SpecularAlbedoRow {
+ public:
+  SpecularAlbedoRow() = default;
+  explicit SpecularAlbedoRow(float roughness);
+  SpecularAlbedoTerms at(float cosTheta) const;
+  SpecularAlbedoTerms average() const { return average_; }
+
+ private:
+  const SpecularAlbedoTerms* lower_ = nullptr;  // the two table rows around the roughness
+  const SpecularAlbedoTerms* upper_ = nullptr;
+  float weight_ = 0;  // of the upper row
+  SpecularAlbedoTerms average_;
+};
+
 }  // namespace chorus::render

@@ -56,17 +56,28 @@ constexpr std::array<uint32_t, 32> makeSobolDimension1() {
   for (int k = 1; k < 32; ++k) v[k] = v[k - 1] ^ (v[k - 1] >> 1);
   return v;
 }
-constexpr std::array<uint32_t, 32> kSobolDimension1 = makeSobolDimension1();
+
+// The matrix-vector product over GF(2), a byte of the index at a time: entry [b][x] is the
+// xor of the columns selected by the bits of x in byte b.
+using SobolByteTable = std::array<std::array<uint32_t, 256>, 4>;
+constexpr SobolByteTable makeSobolByteTable() {
+  const std::array<uint32_t, 32> v = makeSobolDimension1();
+  SobolByteTable table{};
+  for (int b = 0; b < 4; ++b)
+    for (int x = 0; x < 256; ++x)
+      for (int k = 0; k < 8; ++k)
+        if (x & (1 << k)) table[size_t(b)][size_t(x)] ^= v[size_t(8 * b + k)];
+  return table;
+}
+constexpr SobolByteTable kSobolDimension1 = makeSobolByteTable();
 
 inline uint32_t sobolDimension0(uint32_t index) {
   return reverseBits(index);
 }
 
 inline uint32_t sobolDimension1(uint32_t index) {
-  uint32_t x = 0;
-  for (int k = 0; index != 0; ++k, index >>= 1)
-    if (index & 1u) x ^= kSobolDimension1[k];
-  return x;
+  return kSobolDimension1[0][index & 0xffu] ^ kSobolDimension1[1][(index >> 8) & 0xffu] ^
+         kSobolDimension1[2][(index >> 16) & 0xffu] ^ kSobolDimension1[3][index >> 24];
 }
 
 // The top 24 bits as a float in [0, 1): exact, and never rounds up to 1.

@@ -73,7 +73,7 @@ TEST(Atrous, ConstantStaysConstantAndBlackStaysBlack) {
       AtrousParams params;
       params.demodulate = demodulate;
       const Image out = Atrous(params).run(scene.fullInput());
-      EXPECT_LE(test::maxDeviationFrom(out, value.data()), 1e-6f * value[2])
+      EXPECT_LE(test::maxDeviationFrom(out, value.data()), 1e-5f * value[2])
           << value[2] << " demodulate " << demodulate;
     }
   }

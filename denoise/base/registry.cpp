@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "denoise/base/atrous.h"
+#include "denoise/base/bilateral.h"
 #include "denoise/base/sbf.h"
 
 #include "denoise/util/error.h"
@@ -17,6 +18,9 @@ const std::vector<DenoiserEntry>& builtinDenoisers() {
       {"atrous",
        "edge-avoiding à-trous wavelet filter, SVGF weights (Dammertz et al. 2010): fast preview",
        [](ParamMap& p) { return std::make_unique<Atrous>(AtrousParams::fromParams(p)); }},
+      {"bilateral",
+       "joint cross-bilateral filter on normal, albedo, depth and colour (SBF's building block)",
+       [](ParamMap& p) { return std::make_unique<Bilateral>(BilateralParams::fromParams(p)); }},
   };
   return entries;
 }

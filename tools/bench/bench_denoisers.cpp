@@ -1,12 +1,21 @@
 // bench_denoisers: seconds per megapixel and relMSE of every registered base denoiser.
 //
-// Cases (each a DenoiseInput plus a reference image):
-//   synthetic  the procedural scene of tests/support/synthetic_scene.h (exact ground truth),
-//              default 1024×1024, K = 4 sub-buffers × 4 spp, denoised on the full buffer.
-// More case sources (rendered scenes at several spp) plug in as further `*Cases` functions.
-//
-// Every denoiser runs with its default parameters on `--threads` TBB threads (default 2); the
-// time is the best of `--repeat` runs of BaseDenoiser::run (input preparation excluded).
+// Case sources (`--cases`, comma-separated; default synthetic,rendered):
+//   synthetic  the procedural scene of tests/support/synthetic_scene.h with exact ground truth,
+//              default 1024×1024, K = 4 sub-buffers × 4 spp (the timing case)
+//   rendered   scenes rendered in-process by the chorus renderer at each of `--spp` (default
+//              4,16,64; K = 4; width `--render-width`, default 160), against a reference
+//              rendered with `--reference-spp` samples (default 4096; `--reference-cache DIR`
+//              keeps it for the next run):
+//              the default scene (scenes/cornell-box.gltf) and ../shared/scenes/FlightHelmet-Bevy
+//              lit by ../shared/scenes/_environments/studio_small_05_1k.hdr (skipped without
+//              ../shared)
+//   peers      the Tungsten NFOR peer buffers in ../shared/peers/tungsten-nfor (room and glossy
+//              at 4/16/64 spp, with their references)
+// Every denoiser runs with its default parameters on `--threads` TBB threads (default 2) on the
+// full buffer; the time is the best of `--repeat` runs of BaseDenoiser::run. `--oracle` adds,
+// per case, the relMSE of choosing per pixel the best output (using the reference): with all
+// methods and with each one left out — how much each member could add to an ensemble.
 #include <tbb/global_control.h>
 #include <CLI/CLI.hpp>
 
@@ -14,25 +23,38 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <iostream>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "denoise/base/registry.h"
+#include "denoise/buffers/tungsten_dir.h"
+#include "denoise/image/exr_io.h"
 #include "denoise/metrics/metrics.h"
 #include "denoise/util/error.h"
+#include "renderer/render.h"
+#include "renderer/scene/gltf_loader.h"
 #include "tests/support/synthetic_scene.h"
 
 namespace chorus::bench {
 namespace {
+namespace fs = std::filesystem;
 
 struct BenchOptions {
+  std::string cases = "synthetic,rendered";
   int size = 1024;
   int sppPerSubBuffer = 4;
+  float fireflyProbability = 0.0f;
+  std::string spp = "4,16,64";
+  int renderWidth = 160;
+  int referenceSpp = 4096;
+  std::string referenceCache;  // directory of cached reference renders ("" = none)
   int threads = 2;
   int repeat = 1;
-  float fireflyProbability = 0.0f;
+  bool oracle = false;
   std::string methods;  // comma-separated specs; empty = every registered denoiser
 };
 
@@ -41,6 +63,19 @@ struct BenchCase {
   DenoiseInput input;
   Image reference;
 };
+
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ','))
+    if (!item.empty()) items.push_back(item);
+  return items;
+}
+
+fs::path sourceDir() {
+  return fs::path(__FILE__).parent_path().parent_path().parent_path();
+}
 
 std::vector<BenchCase> syntheticCases(const BenchOptions& o) {
   test::SyntheticSceneOptions scene;
@@ -53,11 +88,76 @@ std::vector<BenchCase> syntheticCases(const BenchOptions& o) {
            s.fullInput(), s.truth}};
 }
 
-std::vector<std::string> methodSpecs(const BenchOptions& o) {
-  if (!o.methods.empty()) return splitMethodList(o.methods);
-  std::vector<std::string> specs;
-  for (const DenoiserEntry& entry : builtinDenoisers()) specs.push_back(entry.name);
-  return specs;
+std::vector<BenchCase> renderedCases(const BenchOptions& o) {
+  struct SceneSpec {
+    std::string name;
+    fs::path gltf, environment;
+  };
+  std::vector<SceneSpec> scenes = {{"cornell-box", sourceDir() / "scenes/cornell-box.gltf", {}}};
+  const fs::path shared = sourceDir().parent_path() / "shared/scenes";
+  if (fs::is_directory(shared))
+    scenes.push_back({"flight-helmet+studio", shared / "FlightHelmet-Bevy/FlightHelmet.gltf",
+                      shared / "_environments/studio_small_05_1k.hdr"});
+  else
+    std::fprintf(stderr, "bench_denoisers: %s absent, rendering the default scene only\n",
+                 shared.c_str());
+
+  std::vector<BenchCase> cases;
+  for (const SceneSpec& spec : scenes) {
+    const render::Scene scene = render::buildScene(
+        render::loadGltf(spec.gltf), spec.environment.empty()
+                                         ? render::EnvironmentDesc{}
+                                         : render::environmentFromFile(spec.environment));
+    render::RenderOptions options;
+    options.width = o.renderWidth;
+    options.threads = o.threads;
+    options.spp = o.referenceSpp;
+    options.seed = 1000;  // independent of the inputs' seed
+    const fs::path cached =
+        o.referenceCache.empty()
+            ? fs::path()
+            : fs::path(o.referenceCache) / (spec.name + "-" + std::to_string(o.renderWidth) + "-" +
+                                            std::to_string(o.referenceSpp) + "spp.exr");
+    Image reference;
+    if (!cached.empty() && fs::is_regular_file(cached)) {
+      reference = readExrLayer(cached);
+    } else {
+      const auto start = std::chrono::steady_clock::now();
+      reference = render::render(scene, options).buffers.part(BufferPart::Full).color.mean;
+      std::fprintf(stderr, "bench_denoisers: %s reference %d spp in %.1f s\n", spec.name.c_str(),
+                   o.referenceSpp,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      if (!cached.empty()) {
+        fs::create_directories(cached.parent_path());
+        writeExr(cached, reference);
+      }
+    }
+    for (const std::string& spp : splitList(o.spp)) {
+      options.spp = std::stoi(spp);
+      options.splits = 4;
+      options.seed = 1;
+      cases.push_back({spec.name + " " + spp + "spp",
+                       render::render(scene, options).buffers.input(BufferPart::Full), reference});
+    }
+  }
+  return cases;
+}
+
+std::vector<BenchCase> peerCases() {
+  const fs::path peers = sourceDir().parent_path() / "shared/peers/tungsten-nfor";
+  std::vector<BenchCase> cases;
+  if (!fs::is_directory(peers)) {
+    std::fprintf(stderr, "bench_denoisers: %s absent, no peer cases\n", peers.c_str());
+    return cases;
+  }
+  for (const char* scene : {"room", "glossy"}) {
+    const Image reference = readExrLayer(peers / scene / "reference.exr");
+    for (const char* spp : {"4", "16", "64"})
+      cases.push_back({std::string("tungsten ") + scene + " " + spp + "spp",
+                       readTungstenDirectory(peers / scene / (std::string("spp") + spp)),
+                       reference});
+  }
+  return cases;
 }
 
 struct Timing {
@@ -78,10 +178,63 @@ Timing timeRun(const BaseDenoiser& denoiser, const DenoiseInput& input, Image& o
           processCpuSeconds() - cpuStart};
 }
 
+// relMSE of the per-pixel best of `outputs` (those with include[i]), judged by the reference.
+double oracleRelMse(const std::vector<Image>& outputs, const std::vector<bool>& include,
+                    const Image& reference) {
+  double sum = 0;
+  for (int y = 0; y < reference.height(); ++y)
+    for (int x = 0; x < reference.width(); ++x) {
+      double best = std::numeric_limits<double>::infinity();
+      for (size_t i = 0; i < outputs.size(); ++i) {
+        if (!include[i]) continue;
+        double e = 0;
+        for (int c = 0; c < 3; ++c) {
+          const double r = reference(x, y, c), d = outputs[i](x, y, c) - r;
+          e += d * d / (r * r + kRelMseEpsilon);
+        }
+        best = std::min(best, e);
+      }
+      sum += best;
+    }
+  return sum / (3.0 * double(reference.pixelCount()));
+}
+
+void printOracle(const BenchCase& c, const std::vector<std::string>& specs,
+                 const std::vector<Image>& outputs) {
+  if (outputs.size() < 2) return;
+  std::vector<bool> include(outputs.size(), true);
+  std::printf("| %s | oracle per-pixel best of all | | | %.5f | |\n", c.name.c_str(),
+              oracleRelMse(outputs, include, c.reference));
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    include.assign(outputs.size(), true);
+    include[i] = false;
+    std::printf("| %s | oracle without %s | | | %.5f | |\n", c.name.c_str(), specs[i].c_str(),
+                oracleRelMse(outputs, include, c.reference));
+  }
+}
+
 void run(const BenchOptions& o) {
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
-  const std::vector<std::string> specs = methodSpecs(o);
-  std::vector<BenchCase> cases = syntheticCases(o);
+  const std::vector<std::string> specs =
+      o.methods.empty() ? std::vector<std::string>{} : splitMethodList(o.methods);
+  std::vector<std::string> methods = specs;
+  if (methods.empty())
+    for (const DenoiserEntry& entry : builtinDenoisers()) methods.push_back(entry.name);
+
+  std::vector<BenchCase> cases;
+  for (const std::string& source : splitList(o.cases)) {
+    std::vector<BenchCase> more;
+    if (source == "synthetic") {
+      more = syntheticCases(o);
+    } else if (source == "rendered") {
+      more = renderedCases(o);
+    } else if (source == "peers") {
+      more = peerCases();
+    } else {
+      throw Error("unknown case source '" + source + "' (synthetic, rendered, peers)");
+    }
+    for (BenchCase& c : more) cases.push_back(std::move(c));
+  }
 
   std::printf(
       "threads %d, best of %d run(s); cpu s/Mpx = CPU seconds of all threads (on a busy\n"
@@ -93,7 +246,9 @@ void run(const BenchOptions& o) {
   for (const BenchCase& c : cases) {
     const double megapixels = double(c.input.width()) * c.input.height() / 1e6;
     const double noisy = relMse(c.input.whole.color.mean, c.reference);
-    for (const std::string& spec : specs) {
+    std::vector<Image> outputs;
+    std::vector<std::string> ran;
+    for (const std::string& spec : methods) {
       const auto denoiser = createDenoiser(spec);
       if (denoiser->requirements().halves && !c.input.halves) {
         std::printf("| %s | %s | (needs halves) | | | |\n", c.name.c_str(), spec.c_str());
@@ -110,7 +265,10 @@ void run(const BenchOptions& o) {
                   best.wallSeconds / megapixels, best.cpuSeconds / megapixels,
                   relMse(output, c.reference), noisy);
       std::fflush(stdout);
+      outputs.push_back(std::move(output));
+      ran.push_back(spec);
     }
+    if (o.oracle) printOracle(c, ran, outputs);
   }
 }
 
@@ -120,15 +278,24 @@ void run(const BenchOptions& o) {
 int main(int argc, char** argv) {
   chorus::bench::BenchOptions o;
   CLI::App app{"Seconds per megapixel and relMSE of every registered base denoiser"};
+  app.add_option("--cases", o.cases, "case sources: synthetic, rendered, peers (comma-separated)");
   app.add_option("--size", o.size, "synthetic image width and height")->check(CLI::Range(8, 8192));
-  app.add_option("--spp", o.sppPerSubBuffer, "synthetic samples per sub-buffer (K = 4)")
+  app.add_option("--synthetic-spp", o.sppPerSubBuffer, "synthetic samples per sub-buffer (K = 4)")
       ->check(CLI::Range(1, 1024));
-  app.add_option("--threads", o.threads, "TBB threads")->check(CLI::Range(1, 256));
-  app.add_option("--repeat", o.repeat, "runs per denoiser (the best is reported)")
-      ->check(CLI::Range(1, 100));
   app.add_option("--fireflies", o.fireflyProbability,
                  "probability of a firefly sample (×200) in the synthetic scene")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--spp", o.spp, "rendered cases: samples per pixel, comma-separated");
+  app.add_option("--render-width", o.renderWidth, "rendered cases: image width")
+      ->check(CLI::Range(8, 4096));
+  app.add_option("--reference-spp", o.referenceSpp, "rendered cases: reference samples per pixel")
+      ->check(CLI::Range(1, 1 << 20));
+  app.add_option("--reference-cache", o.referenceCache,
+                 "rendered cases: directory to keep reference renders in and reuse them from");
+  app.add_option("--threads", o.threads, "TBB threads")->check(CLI::Range(1, 256));
+  app.add_option("--repeat", o.repeat, "runs per denoiser (the best is reported)")
+      ->check(CLI::Range(1, 100));
+  app.add_flag("--oracle", o.oracle, "per-pixel oracle selection, with each method left out");
   app.add_option("--methods", o.methods, "comma-separated denoiser specs (default: all)");
   CLI11_PARSE(app, argc, argv);
   try {

@@ -78,6 +78,9 @@ Bsdf::Bsdf(const MaterialPoint& material) : m_(material) {
   ggx_ = GgxDistribution::fromRoughness(m_.roughness);
   transmits_ = (1.0f - m_.metallic) * m_.transmission > 0 && m_.baseColor.maxComponent() > 0;
   solidTransmission_ = !m_.thinWalled && transmits_;
+  // specular = 0 removes the layer (and with metallic = 0 leaves a plain Lambertian, which then
+  // skips all microfacet work).
+  roughReflection_ = !smooth_ && (m_.metallic > 0 || m_.specular > 0);
 
   // KHR_materials_specular: f0 = min(f0(ior) · specularColor, 1) · specular, f90 = specular.
   const float f0Ior = f0FromIor(eta_);
@@ -85,7 +88,7 @@ Bsdf::Bsdf(const MaterialPoint& material) : m_(material) {
          std::min(f0Ior * m_.specularColor.b, 1.0f)};
   f0Max_ = f0_.maxComponent();
   SpecularAlbedoTerms average = kSmoothLayerAverage;
-  if (!smooth_) {
+  if (!smooth_ && m_.specular > 0) {
     layerAlbedoRow_ = SpecularAlbedoRow(m_.roughness);
     average = layerAlbedoRow_.average();
   }
@@ -128,7 +131,7 @@ Bsdf::Context Bsdf::context(Vec3f wo) const {
   c.inside = c.flip && solidTransmission_;
   c.wo = c.flip ? mirrorZ(wo) : wo;
   if (!c.inside) c.layerAlbedoO = layerAlbedo(c.wo.z);
-  if (!smooth_) c.lambdaO = ggx_.lambda(c.wo);
+  if (roughReflection_ || (!smooth_ && transmits_)) c.lambdaO = ggx_.lambda(c.wo);
   c.weights = lobeWeights(c);
   return c;
 }
@@ -180,7 +183,7 @@ BsdfEval Bsdf::evalCanonical(const Context& c, Vec3f wi) const {
       e.f += diffuseF(c.layerAlbedoO, wi.z);
       e.pdf += w.diffuse * cosineHemispherePdfSolidAngle(wi.z);
     }
-    if (smooth_) return e;
+    if (!roughReflection_) return e;
     const Vec3f h = normalize(wo + wi);
     const float cosOH = dot(wo, h);
     const float D = ggx_.D(h);

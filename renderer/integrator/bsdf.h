@@ -99,8 +99,9 @@ class Bsdf {
 
   MaterialPoint m_;  // clamped to valid ranges
   GgxDistribution ggx_{1.0f};
-  SpecularAlbedoRow layerAlbedoRow_;  // rough only
+  SpecularAlbedoRow layerAlbedoRow_;  // rough with a specular layer only
   bool smooth_ = false;
+  bool roughReflection_ = false;    // a rough metal or specular-layer lobe exists
   bool transmits_ = false;          // hasTransmission()
   bool solidTransmission_ = false;  // refracts into a closed volume (wo.z < 0 is inside)
   float eta_ = 1.5f;                // IOR used by the interface (clamped away from 1)

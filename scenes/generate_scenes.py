@@ -123,7 +123,11 @@ class Mesh:
 
     def quad(self, corners, facing, uv_scale=(1.0, 1.0), tangent=None):
         """A flat quad (corners in order around it) whose front side faces `facing`."""
-        normal = normalize(cross(sub(corners[1], corners[0]), sub(corners[2], corners[0])))
+        # Newell's normal: the best-fit plane's, also for the slightly non-planar measured walls.
+        normal = [0.0, 0.0, 0.0]
+        for a, b in zip(corners, corners[1:] + corners[:1]):
+            normal = add(normal, cross(a, b))
+        normal = normalize(normal)
         if dot(normal, facing) < 0:
             corners = corners[::-1]
             normal = scale(normal, -1.0)

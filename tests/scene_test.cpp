@@ -109,6 +109,29 @@ TEST(Scene, RayOffsetsNeitherSelfIntersectNorLeakAtAnyScale) {
   }
 }
 
+// A plane lying exactly on a coordinate plane has no rounding error along its normal: the
+// offset must still move rays off it.
+TEST(Scene, RaysLeaveAPlaneAtZeroCoordinate) {
+  MeshDesc quad;
+  quad.positions = {{-3, 0, -3}, {3, 0, -3}, {3, 0, 3}, {-3, 0, 3}};
+  quad.indices = {0, 2, 1, 0, 3, 2};
+  const Scene scene = buildScene(sceneWith({quad}), EnvironmentDesc{});
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  int selfHits = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3f start{4 * u(rng) - 2, 1, 4 * u(rng) - 2};
+    Hit hit;
+    ASSERT_TRUE(scene.intersect({start, {0, -1, 0}}, &hit));
+    const SurfaceInteraction si = scene.interaction(hit, {0, -1, 0});
+    Vec3f d = sampleUniformSphere({u(rng), u(rng)});
+    if (d.y < 0) d.y = -d.y;
+    const Vec3f origin = offsetRayOrigin(si.position, si.positionError, si.geometricNormal, d);
+    selfHits += scene.occluded(origin, d, std::numeric_limits<float>::infinity());
+  }
+  EXPECT_EQ(selfHits, 0);
+}
+
 TEST(Scene, AlphaMaskCutsOutTexelsAndBlendKeepsAFractionOfHits) {
   test::TempDir dir;
   test::GltfBuilder b;

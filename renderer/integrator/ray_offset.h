@@ -8,6 +8,7 @@
 // projection, then one more float step away from the surface, puts it strictly on the side of
 // the outgoing direction, so the new ray cannot re-hit the surface it left and cannot start on
 // the far side of it (no leaks).
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -27,10 +28,16 @@ inline Vec3f barycentricPositionError(Vec3f p0, Vec3f p1, Vec3f p2, float b0, fl
   return (abs(p0 * b0) + abs(p1 * b1) + abs(p2 * b2)) * (roundingGamma(7) * kOffsetSafety);
 }
 
+// Smallest offset, for points whose rounding bound is 0 (all vertices at coordinate 0).
+inline constexpr float kMinOffset = 1e-9f;
+
 // The origin for a ray leaving point p (with error bound pError) in direction w; n is the
-// geometric normal (either orientation).
+// geometric normal (either orientation). The bound is used isotropically (its largest
+// component): an axis without rounding error (a plane at y = 0) still gets moved off the
+// surface, since Embree would report the plane again at t = 0.
 inline Vec3f offsetRayOrigin(Vec3f p, Vec3f pError, Vec3f n, Vec3f w) {
-  const float d = dot(abs(n), pError);
+  const float e = std::max(maxComponent(pError), kMinOffset);
+  const float d = e * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
   Vec3f offset = n * d;
   if (dot(w, n) < 0) offset = -offset;
   Vec3f po = p + offset;

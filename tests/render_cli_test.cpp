@@ -1,0 +1,156 @@
+// `chorus render` and `chorus info` end to end: outputs, stats.json, layers, and clean failures
+// (one line naming the file, exit code 2, nothing written).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "denoise/buffers/buffers_exr.h"
+#include "denoise/image/exr_io.h"
+#include "tests/support/gltf_builder.h"
+#include "tests/support/test_support.h"
+
+namespace chorus {
+namespace {
+
+using nlohmann::json;
+using test::runChorus;
+using test::TempDir;
+
+// A small lit scene: a Lambertian quad facing +z with a point light and a camera in front.
+std::filesystem::path writeLitScene(const TempDir& dir, bool withLight = true) {
+  test::GltfBuilder b;
+  b.addQuad({-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0},
+            b.addMaterial(test::lambertianMaterial(0.5f, 0.5f, 0.5f)));
+  if (withLight) {
+    const int light = b.addPunctualLight({{"type", "point"}, {"intensity", 4}});
+    b.addNode({{"translation", {0, 0, 2}},
+               {"extensions", {{"KHR_lights_punctual", {{"light", light}}}}}});
+  }
+  const int cam =
+      b.addCamera({{"type", "perspective"},
+                   {"perspective", {{"yfov", 0.9}, {"znear", 0.1}, {"aspectRatio", 1.5}}}});
+  b.addNode({{"camera", cam}, {"translation", {0, 0, 3}}});
+  const auto path = dir / "lit.gltf";
+  b.writeGltf(path);
+  return path;
+}
+
+int lineCount(const std::string& s) {
+  return int(std::count(s.begin(), s.end(), '\n'));
+}
+
+TEST(RenderCli, WritesExrPngAndStats) {
+  TempDir dir;
+  const auto scene = writeLitScene(dir);
+  const auto out = dir / "out";
+  const auto r = runChorus({"render", scene.string(), "--spp", "8", "--width", "12", "--splits",
+                            "4", "--seed", "3", "--out", out.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(lineCount(r.err), 1) << r.err;                    // not a terminal: one summary line
+  EXPECT_NE(r.err.find("12x8"), std::string::npos) << r.err;  // height from the camera's aspect
+  for (const char* f : {"render.exr", "color.png", "stats.json"})
+    EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
+
+  std::ifstream statsFile(out / "stats.json");
+  const json stats = json::parse(statsFile);
+  EXPECT_EQ(stats["width"], 12);
+  EXPECT_EQ(stats["height"], 8);
+  EXPECT_EQ(stats["spp"], 8);
+  EXPECT_EQ(stats["splits"], 4);
+  EXPECT_EQ(stats["samples"], 12 * 8 * 8);
+  EXPECT_EQ(stats["triangles"], 2);
+  EXPECT_EQ(stats["nan_samples_dropped"], 0);
+  EXPECT_GE(stats["rays"].get<double>(), 12 * 8 * 8);
+  for (const char* key : {"load", "bvh_build", "render"})
+    EXPECT_GE(stats["seconds"][key].get<double>(), 0.0);
+  EXPECT_GT(stats["samples_per_second"].get<double>(), 0.0);
+
+  const SampleBuffers buffers =
+      sampleBuffersFromLayers(readExr(out / "render.exr"), out / "render.exr");
+  ASSERT_EQ(buffers.splitCount(), 4);
+  EXPECT_EQ(buffers.width(), 12);
+  EXPECT_EQ(buffers.sub(2).sampleCount.at(3, 3, 0), 2.0f);
+  EXPECT_GT(buffers.part(BufferPart::Full).color.mean.at(6, 4, 0), 0.0f);
+}
+
+TEST(RenderCli, QuietPrintsNothingAndNoLightsGetsOneLine) {
+  TempDir dir;
+  const auto scene = writeLitScene(dir, false);
+  auto r = runChorus({"render", scene.string(), "--spp", "1", "--width", "4", "--height", "4",
+                      "--quiet", "--out", (dir / "q").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(r.out, "");
+  r = runChorus({"render", scene.string(), "--spp", "1", "--width", "4", "--height", "4", "--out",
+                 (dir / "n").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("has no lights: rendering under a uniform white environment (radiance 1)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(lineCount(r.err), 2) << r.err;
+  // With an explicit background the scene is lit by it and nothing is said.
+  r = runChorus({"render", scene.string(), "--spp", "1", "--width", "4", "--height", "4",
+                 "--background", "0.5,0.25,0", "--out", (dir / "b").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.err.find("no lights"), std::string::npos) << r.err;
+}
+
+void expectCleanFailure(const std::vector<std::string>& args, const std::string& fragment,
+                        const std::filesystem::path& out) {
+  const auto r = runChorus(args);
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_EQ(lineCount(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(fragment), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out / "render.exr"));
+  EXPECT_FALSE(std::filesystem::exists(out / "stats.json"));
+}
+
+TEST(RenderCli, FailsCleanlyOnBadInput) {
+  TempDir dir;
+  const auto scene = writeLitScene(dir);
+  const auto out = dir / "out";
+  const std::string o = out.string();
+  expectCleanFailure({"render", (dir / "missing.gltf").string(), "--out", o},
+                     "missing.gltf: no such file", out);
+  std::ofstream(dir / "broken.gltf") << "{ \"asset\": ";
+  expectCleanFailure({"render", (dir / "broken.gltf").string(), "--out", o},
+                     "broken.gltf: not a readable glTF", out);
+  expectCleanFailure({"render", scene.string(), "--camera", "3", "--out", o}, "has no camera 3",
+                     out);
+  expectCleanFailure({"render", scene.string(), "--denoise", "nfor", "--out", o},
+                     "--denoise 'nfor'", out);
+  expectCleanFailure({"render", scene.string(), "--env", (dir / "sky.hdr").string(), "--out", o},
+                     "sky.hdr: no such file", out);
+  expectCleanFailure({"render", scene.string(), "--background", "red", "--out", o},
+                     "'red' is not a colour", out);
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // Flag validation is CLI11's (its message plus a --help hint).
+  const auto r = runChorus({"render", scene.string(), "--splits", "3", "--out", o});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("--splits: 3 not in {1,2,4}"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // An output path that is a file.
+  std::ofstream(dir / "file") << "x";
+  expectCleanFailure(
+      {"render", scene.string(), "--spp", "1", "--width", "4", "--out", (dir / "file").string()},
+      "file", dir / "file");
+}
+
+TEST(InfoCli, SummarisesTheScene) {
+  TempDir dir;
+  const auto scene = writeLitScene(dir);
+  const auto r = runChorus({"info", scene.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("triangles   2"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 point"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("lambertian"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("perspective"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("bounds      min (-1, -1, 0) max (1, 1, 0)"), std::string::npos) << r.out;
+  const auto bad = runChorus({"info", (dir / "none.glb").string()});
+  EXPECT_EQ(bad.exitCode, 2);
+  EXPECT_NE(bad.err.find("none.glb: no such file"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace chorus

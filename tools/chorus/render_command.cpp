@@ -1,0 +1,180 @@
+// chorus render SCENE: path-trace a glTF scene into K independent sub-buffers and write
+// DIR/render.exr (every layer), DIR/color.png (preview) and DIR/stats.json.
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <iostream>
+#include <string>
+
+#include "denoise/buffers/buffers_exr.h"
+#include "denoise/image/exr_io.h"
+#include "denoise/image/png_io.h"
+#include "denoise/util/atomic_file.h"
+#include "denoise/util/error.h"
+#include "renderer/render.h"
+#include "renderer/scene/environment.h"
+#include "renderer/scene/gltf_loader.h"
+#include "tools/chorus/command.h"
+#include "tools/chorus/progress_bar.h"
+
+namespace chorus::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace chorus::render;
+
+struct RenderArgs {
+  std::string scene;
+  std::string out = "out";
+  RenderOptions options;
+  int splits = 0;  // 0: what the denoising stage needs
+  std::string background, env;
+  float envRotate = 0, envIntensity = 1;
+  std::string denoise = "none";
+  bool quiet = false;
+};
+
+// The stage after rendering. Only "none" exists so far; the ensemble plugs in here: it parses
+// its spec, says how many sub-buffers it needs, and runs on the buffers after they are written.
+struct DenoiseStage {
+  std::string spec;
+  int splitsNeeded() const { return 1; }
+  void run(const SampleBuffers&, const fs::path&, nlohmann::ordered_json&) const {}
+};
+
+DenoiseStage parseDenoiseStage(const std::string& spec) {
+  if (spec != "none") throw Error("--denoise '" + spec + "' is not available (only 'none' so far)");
+  return {spec};
+}
+
+EnvironmentDesc environmentFrom(const RenderArgs& args) {
+  if (!args.env.empty()) return environmentFromFile(args.env, args.envRotate, args.envIntensity);
+  if (!args.background.empty()) {
+    EnvironmentDesc e = EnvironmentDesc::constant(parseRgb(args.background));
+    e.intensity = args.envIntensity;
+    return e;
+  }
+  return {};
+}
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderStats& s, double loadSeconds,
+                                 double buildSeconds, const Scene& scene,
+                                 const std::vector<std::string>& warnings) {
+  nlohmann::ordered_json j;
+  j["scene"] = args.scene;
+  j["width"] = s.width;
+  j["height"] = s.height;
+  j["spp"] = s.spp;
+  j["splits"] = s.splits;
+  j["seed"] = args.options.seed;
+  j["max_depth"] = args.options.maxDepth;
+  j["camera"] = args.options.camera;
+  j["threads"] = args.options.threads;
+  j["environment"] = scene.usesDefaultEnvironment() ? "default white (no lights in scene)"
+                     : !args.env.empty()            ? args.env
+                     : !args.background.empty()     ? "constant " + args.background
+                                                    : "none";
+  j["seconds"] = {{"load", loadSeconds}, {"bvh_build", buildSeconds}, {"render", s.renderSeconds}};
+  j["samples"] = s.samples;
+  j["samples_per_second"] = s.samplesPerSecond();
+  j["rays"] = s.rays;
+  j["rays_per_second"] = s.raysPerSecond();
+  j["triangles"] = s.triangles;
+  j["nan_samples_dropped"] = s.nanSamplesDropped;
+  j["warnings"] = warnings;
+  j["denoise"] = args.denoise;
+  j["chorus_version"] = CHORUS_VERSION;
+  return j;
+}
+
+void runRender(RenderArgs args) {
+  const DenoiseStage denoise = parseDenoiseStage(args.denoise);
+  args.options.splits = args.splits > 0 ? args.splits : denoise.splitsNeeded();
+  const EnvironmentDesc environment = environmentFrom(args);
+
+  auto start = std::chrono::steady_clock::now();
+  SceneDesc desc = loadGltf(args.scene);
+  const double loadSeconds = secondsSince(start);
+  const std::vector<std::string> warnings = desc.warnings;
+  for (const std::string& w : warnings)
+    std::cerr << "chorus: warning: " << args.scene << ": " << w << "\n";
+
+  start = std::chrono::steady_clock::now();
+  const Scene scene = buildScene(std::move(desc), environment);
+  const double buildSeconds = secondsSince(start);
+  if (scene.usesDefaultEnvironment() && !args.quiet)
+    std::cerr << "chorus: " << args.scene
+              << " has no lights: rendering under a uniform white environment (radiance 1)\n";
+
+  ProgressBar bar(!args.quiet && ProgressBar::stderrIsTerminal());
+  const RenderResult result =
+      render::render(scene, args.options, [&bar](const RenderProgress& p) { bar.update(p); });
+  bar.finish();
+
+  const fs::path out = args.out;
+  ensureDirectory(out);
+  writeExr(out / "render.exr", sampleBuffersToLayers(result.buffers), ExrPixelType::Float);
+  writePng(out / "color.png", result.buffers.part(BufferPart::Full).color.mean);
+  nlohmann::ordered_json stats =
+      statsJson(args, result.stats, loadSeconds, buildSeconds, scene, warnings);
+  denoise.run(result.buffers, out, stats);
+  writeTextAtomically(out / "stats.json", stats.dump(2) + "\n");
+
+  if (!args.quiet) {
+    const RenderStats& s = result.stats;
+    std::fprintf(stderr,
+                 "chorus: rendered %s at %dx%d, %d spp, %d split(s) in %.2f s: %.2f M samples/s, "
+                 "%.2f M rays/s, %llu NaN sample(s) dropped -> %s\n",
+                 args.scene.c_str(), s.width, s.height, s.spp, s.splits, s.renderSeconds,
+                 s.samplesPerSecond() / 1e6, s.raysPerSecond() / 1e6,
+                 static_cast<unsigned long long>(s.nanSamplesDropped), out.c_str());
+  }
+}
+
+const RegisterCommand registration(30, [](CLI::App& app) {
+  auto args = std::make_shared<RenderArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "render",
+      "Path-trace a glTF scene into independent sub-buffers (colour, albedo, normal, "
+      "depth, visibility, with variances); writes DIR/render.exr, color.png, stats.json");
+  cmd->add_option("scene", args->scene, "glTF scene (.gltf or .glb)")->required();
+  cmd->add_option("--out", args->out, "Output directory")->capture_default_str();
+  cmd->add_option("--spp", args->options.spp, "Samples per pixel (over all sub-buffers)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--width", args->options.width, "Image width (default: from the camera)");
+  cmd->add_option("--height", args->options.height, "Image height (default: 512, or from --width)");
+  cmd->add_option("--splits", args->splits,
+                  "Independent sub-buffers K: 1, 2 or 4 (default: what --denoise needs)")
+      ->check(CLI::IsMember({1, 2, 4}));
+  cmd->add_option("--seed", args->options.seed, "Sampler seed")->capture_default_str();
+  cmd->add_option("--threads", args->options.threads, "Worker threads (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--max-depth", args->options.maxDepth, "Maximum bounces per path")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--camera", args->options.camera, "Camera index (glTF camera nodes in order)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  auto* background = cmd->add_option("--background", args->background,
+                                     "Constant environment radiance R,G,B (or one grey value)");
+  auto* env = cmd->add_option("--env", args->env, "Equirectangular environment map (.hdr or .exr)");
+  background->excludes(env);
+  cmd->add_option("--env-rotate", args->envRotate, "Rotate the environment about +Y, degrees")
+      ->capture_default_str();
+  cmd->add_option("--env-intensity", args->envIntensity, "Scale the environment radiance")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--denoise", args->denoise, "Denoising after the render: none")
+      ->capture_default_str();
+  cmd->add_flag("--quiet", args->quiet, "No progress bar or summary line");
+  cmd->callback([args] { runRender(*args); });
+});
+
+}  // namespace
+}  // namespace chorus::cli

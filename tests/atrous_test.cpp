@@ -123,6 +123,8 @@ TEST(Atrous, VectorKernelsMatchTheScalarKernelBitForBit) {
       const Image scalar = runAtrous(b, params, AtrousKernelPath::Scalar);
       EXPECT_TRUE(test::bitIdentical(scalar, runAtrous(b, params, AtrousKernelPath::Sse2)))
           << "SSE2, σn " << sigmaN << ", unknown normals " << unknownNormals;
+      EXPECT_TRUE(test::bitIdentical(scalar, runAtrous(b, params, AtrousKernelPath::Avx2)))
+          << "AVX2 (or SSE2), σn " << sigmaN << ", unknown normals " << unknownNormals;
       EXPECT_TRUE(test::bitIdentical(scalar, runAtrous(b, params, AtrousKernelPath::Widest)))
           << "widest, σn " << sigmaN << ", unknown normals " << unknownNormals;
     }

@@ -24,7 +24,8 @@ AtrousParams AtrousParams::fromParams(ParamMap& params) {
   p.sigmaL = params.getFloat("sigmaL", p.sigmaL);
   p.demodulate = params.getBool("demodulate", p.demodulate);
   p.clampFireflies = params.getBool("clampFireflies", p.clampFireflies);
-  if (p.iterations < 0 || p.iterations > 10) throw Error("atrous: iterations must be in [0, 10]");
+  if (p.iterations < 0 || p.iterations > kMaxIterations)
+    throw Error("atrous: iterations must be in [0, " + std::to_string(kMaxIterations) + "]");
   if (!(p.sigmaZ > 0) || !std::isfinite(p.sigmaZ)) throw Error("atrous: sigmaZ must be > 0");
   if (!(p.sigmaL > 0) || !std::isfinite(p.sigmaL)) throw Error("atrous: sigmaL must be > 0");
   // Powers of two only: w_n is then a chain of squarings, which vectorises.
@@ -67,9 +68,9 @@ float gentleDifference(const float* z, size_t i, size_t stride, int pos, int siz
   return back ? b : f;
 }
 
-Guide makeGuide(const SubBuffer& buffer, float sigmaZ) {
+Guide makeGuide(const SubBuffer& buffer, float sigmaZ, int margin) {
   const int w = buffer.width(), h = buffer.height();
-  Guide g{PaddedPlanes(w, h, kGuidePlanes)};
+  Guide g{PaddedPlanes(w, h, kGuidePlanes, margin)};
   PaddedPlanes& out = g.planes;
   const float scale = 1.0f / maxFiniteDepth(buffer.depth.mean);
   const float* depth = buffer.depth.mean.data();
@@ -139,60 +140,108 @@ void clampFireflies(PaddedPlanes& state) {
 // The row filter for a kernel path: AVX2 where requested and available, else SSE2 (or scalar).
 AtrousRowFilter atrousRowFilter(AtrousKernelPath path, int squarings, bool unknownNormals) {
 #if defined(__x86_64__) && defined(__GNUC__)
+  static const bool avx512 = __builtin_cpu_supports("avx512f");
   static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (avx2 && path == AtrousKernelPath::Widest)
+  if (avx512 && path == AtrousKernelPath::Widest)
+    if (AtrousRowFilter f = selectAtrousRowFilterAvx512(squarings, unknownNormals)) return f;
+  if (avx2 && (path == AtrousKernelPath::Widest || path == AtrousKernelPath::Avx2))
     if (AtrousRowFilter f = selectAtrousRowFilterAvx2(squarings, unknownNormals)) return f;
 #endif
 #if defined(__SSE2__)
-  if (path != AtrousKernelPath::Scalar) return selectRowFilter<Float4x2>(squarings, unknownNormals);
+  if (path != AtrousKernelPath::Scalar)
+    return selectRowFilter<Pair<Float4>>(squarings, unknownNormals);
 #endif
   return selectRowFilter<Float1>(squarings, unknownNormals);
+}
+
+#if defined(__SSE2__)
+using StatisticsLanes = Float4;
+#else
+using StatisticsLanes = Float1;
+#endif
+
+// Luminance of row y and its inverse tolerance 1 / (σ_l √(g3×3 ∗ Var) + ε_l), with the 3×3
+// Gaussian (1/4 centre, 1/8 edges, 1/16 corners) clipped and renormalised at the borders,
+// applied separably ([1 2 1] / 4 per axis, / 3 where one side is missing, / 2 with none).
+// `rowScratch` holds 3 rows of w floats.
+void levelStatistics(const PaddedPlanes& state, float sigmaL, int y, PaddedPlanes& statistics,
+                     std::vector<float>& rowScratch) {
+  const int w = state.width(), h = state.height();
+  const float* variance = state.plane(kVariance);
+  float* smoothed[3] = {rowScratch.data(), rowScratch.data() + w, rowScratch.data() + 2 * w};
+  const auto axisNorm = [](int pos, int size) {
+    return 1.0f / (2.0f + (pos > 0 ? 1.0f : 0.0f) + (pos + 1 < size ? 1.0f : 0.0f));
+  };
+  for (int dy = -1; dy <= 1; ++dy) {
+    const int qy = y + dy;
+    float* out = smoothed[dy + 1];
+    if (qy < 0 || qy >= h) {
+      std::fill(out, out + w, 0.0f);
+      continue;
+    }
+    const float* v = variance + state.index(0, qy);  // columns −1 and w read the zero margin
+    for (int x = 0; x < w; ++x) out[x] = v[x - 1] + 2.0f * v[x] + v[x + 1];
+    out[0] *= axisNorm(0, w);
+    for (int x = 1; x < w - 1; ++x) out[x] *= 0.25f;
+    if (w > 1) out[w - 1] *= axisNorm(w - 1, w);
+  }
+  const float yNorm = axisNorm(y, h);
+  float* luminance = statistics.plane(0) + state.index(0, y);
+  float* tolerance = statistics.plane(1) + state.index(0, y);
+  const float* color[3] = {state.plane(kRed) + state.index(0, y),
+                           state.plane(kGreen) + state.index(0, y),
+                           state.plane(kBlue) + state.index(0, y)};
+  for (int x = 0; x < w; ++x) {
+    luminance[x] =
+        kLuminance[0] * color[0][x] + kLuminance[1] * color[1][x] + kLuminance[2] * color[2][x];
+    smoothed[1][x] = (smoothed[0][x] + 2.0f * smoothed[1][x] + smoothed[2][x]) * yNorm;
+  }
+  const auto toleranceOf = [&](auto lanes, int x) {
+    using F = decltype(lanes);
+    const F g = F::load(smoothed[1] + x);
+    (F::broadcast(1.0f) / (F::broadcast(sigmaL) * sqrt(g) + F::broadcast(kLuminanceEpsilon)))
+        .store(tolerance + x);
+  };
+  int x = 0;
+  for (; x + StatisticsLanes::kWidth <= w; x += StatisticsLanes::kWidth)
+    toleranceOf(StatisticsLanes{}, x);
+  for (; x < w; ++x) toleranceOf(Float1{}, x);
 }
 
 // One à-trous level with tap spacing `step`: state → next (colour and luminance variance).
 // `statistics` is scratch for the level's luminance and inverse luminance tolerance.
 void atrousLevel(const Guide& g, const AtrousParams& params, AtrousKernelPath path, int step,
-                 const PaddedPlanes& state, PaddedPlanes& statistics, PaddedPlanes& next) {
+                 const PaddedPlanes& state, PaddedPlanes& statistics, PaddedPlanes& next,
+                 const std::vector<float>& inside) {
   const int w = state.width(), h = state.height();
-  const size_t stride = state.rowStride();
-  // Luminance, and 1 / (σ_l √(g3×3 ∗ Var) + ε) with the 3×3 Gaussian (1/4 centre, 1/8 edges,
-  // 1/16 corners) clipped and renormalised at the borders.
-  tbb::parallel_for(0, h, [&](int y) {
-    const float* variance = state.plane(kVariance);
-    for (int x = 0; x < w; ++x) {
-      const size_t i = state.index(x, y);
-      statistics.plane(0)[i] = luminanceOf(state, i);
-      float sum = 0, weight = 0;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int qx = x + dx, qy = y + dy;
-          if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
-          const float k = (dx == 0 ? 2.0f : 1.0f) * (dy == 0 ? 2.0f : 1.0f);
-          sum += k * variance[state.index(qx, qy)];
-          weight += k;
-        }
-      statistics.plane(1)[i] = 1.0f / (params.sigmaL * std::sqrt(sum / weight) + kLuminanceEpsilon);
-    }
+  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+    std::vector<float> scratch(size_t(3 * w));
+    for (int y = rows.begin(); y < rows.end(); ++y)
+      levelStatistics(state, params.sigmaL, y, statistics, scratch);
   });
 
+  // Pointers to pixel (0, 0) of each plane (all planes share the padded layout).
+  const size_t origin = state.index(0, 0);
   AtrousLevelInputs in;
   in.w = w;
   in.h = h;
   in.step = step;
-  in.stride = stride;
-  in.z = g.planes.plane(kDepth);
-  in.gx = g.planes.plane(kGradientX);
-  in.gy = g.planes.plane(kGradientY);
-  in.nx = g.planes.plane(kNormalX);
-  in.ny = g.planes.plane(kNormalY);
-  in.nz = g.planes.plane(kNormalZ);
-  in.hasNormal = g.planes.plane(kHasNormal);
-  in.luminance = statistics.plane(0);
-  in.inverseTolerance = statistics.plane(1);
-  in.variance = state.plane(kVariance);
-  for (int c = 0; c < 3; ++c) in.color[c] = state.plane(kRed + c);
-  float* const out[3] = {next.plane(kRed), next.plane(kGreen), next.plane(kBlue)};
-  float* outVariance = next.plane(kVariance);
+  in.stride = ptrdiff_t(state.rowStride());
+  in.inside = inside.data() + state.margin();
+  in.z = g.planes.plane(kDepth) + origin;
+  in.gx = g.planes.plane(kGradientX) + origin;
+  in.gy = g.planes.plane(kGradientY) + origin;
+  in.nx = g.planes.plane(kNormalX) + origin;
+  in.ny = g.planes.plane(kNormalY) + origin;
+  in.nz = g.planes.plane(kNormalZ) + origin;
+  in.hasNormal = g.planes.plane(kHasNormal) + origin;
+  in.luminance = statistics.plane(0) + origin;
+  in.inverseTolerance = statistics.plane(1) + origin;
+  in.variance = state.plane(kVariance) + origin;
+  for (int c = 0; c < 3; ++c) in.color[c] = state.plane(kRed + c) + origin;
+  float* const out[3] = {next.plane(kRed) + origin, next.plane(kGreen) + origin,
+                         next.plane(kBlue) + origin};
+  float* outVariance = next.plane(kVariance) + origin;
   const int squarings = params.sigmaN > 0 ? std::countr_zero(unsigned(params.sigmaN)) : -1;
   const AtrousRowFilter filterRow = atrousRowFilter(path, squarings, g.unknownNormals);
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
@@ -212,8 +261,10 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKerne
     return params.demodulate ? std::max(std::isfinite(albedo[e]) ? albedo[e] : 0.0f, kAlbedoFloor)
                              : 1.0f;
   };
+  // Taps reach 2·2^(iterations−1) pixels past the borders: zero margins that wide.
+  const int margin = 1 << params.iterations;
   // Demodulate; luminance variance (Σ a_c √V_c)², V_c of the demodulated colour.
-  PaddedPlanes state(w, h, kStatePlanes);
+  PaddedPlanes state(w, h, kStatePlanes, margin);
   tbb::parallel_for(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const size_t i = size_t(y) * size_t(w) + size_t(x), o = state.index(x, y);
@@ -229,10 +280,12 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKerne
   });
   if (params.clampFireflies) clampFireflies(state);
 
-  const Guide guide = makeGuide(buffer, params.sigmaZ);
-  PaddedPlanes statistics(w, h, 2), next(w, h, kStatePlanes);
+  const Guide guide = makeGuide(buffer, params.sigmaZ, margin);
+  PaddedPlanes statistics(w, h, 2, margin), next(w, h, kStatePlanes, margin);
+  std::vector<float> inside(size_t(w + 2 * margin), 0.0f);
+  std::fill(inside.begin() + margin, inside.begin() + margin + w, 1.0f);
   for (int i = 0; i < params.iterations; ++i) {
-    atrousLevel(guide, params, path, 1 << i, state, statistics, next);
+    atrousLevel(guide, params, path, 1 << i, state, statistics, next, inside);
     std::swap(state, next);
   }
 

@@ -26,6 +26,7 @@
 namespace chorus {
 
 struct AtrousParams {
+  static constexpr int kMaxIterations = 6;  // the zero margins grow as 2^iterations
   int iterations = 5;           // N: à-trous levels, tap spacing 2^i (5 → a 125-pixel footprint)
   float sigmaZ = 1.0f;          // σ_z: depth tolerance in units of the depth gradient (SVGF)
   float sigmaN = 128.0f;        // σ_n: exponent of the normal weight (SVGF)
@@ -38,9 +39,9 @@ struct AtrousParams {
   static AtrousParams fromParams(ParamMap& params);
 };
 
-// Which implementation of the inner kernel runs: the widest the CPU supports (AVX2 or SSE2),
-// or a narrower one. All give bit-identical results; tests compare them.
-enum class AtrousKernelPath { Widest, Sse2, Scalar };
+// Which implementation of the inner kernel runs: the widest the CPU supports (AVX-512F, AVX2
+// or SSE2), or a narrower one. All give bit-identical results; tests compare them.
+enum class AtrousKernelPath { Widest, Avx2, Sse2, Scalar };
 
 // Runs the filter on one buffer (colour and its variance, albedo, normal, depth).
 Image runAtrous(const SubBuffer& buffer, const AtrousParams& params,

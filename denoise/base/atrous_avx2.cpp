@@ -3,7 +3,7 @@
 // built for the portable baseline (x86-64-v2), so AVX2 is enabled here with a target pragma
 // that covers only the code below it: every header is included *before* the pragma, so that
 // no inline function of a shared header is compiled with AVX2 (the linker could otherwise
-// pick that copy for the whole program). FMA stays off: without contraction every lane
+// pick that copy for the whole program). Contraction into FMA is switched off: every lane
 // computes exactly the float operations of the SSE2 and scalar paths, so results do not
 // depend on which path ran.
 #include <algorithm>
@@ -21,6 +21,9 @@
 
 #pragma GCC push_options
 #pragma GCC target("avx2")
+// No contraction of a·b + c into FMA (AVX-512F makes FMA available): the same roundings as
+// the other paths, lane for lane.
+#pragma GCC optimize("fp-contract=off")
 
 namespace chorus {
 namespace {
@@ -76,7 +79,7 @@ Float8 expNegated(Float8 e) {
 namespace chorus {
 
 AtrousRowFilter selectAtrousRowFilterAvx2(int squarings, bool unknownNormals) {
-  return selectRowFilter<Float8>(squarings, unknownNormals);
+  return selectRowFilter<Pair<Float8>>(squarings, unknownNormals);
 }
 
 }  // namespace chorus

@@ -13,10 +13,13 @@
 
 namespace chorus {
 
-// Everything one à-trous level reads, as padded planes (index y·stride + x).
+// Everything one à-trous level reads, as padded planes: pointers address pixel (0, 0), pixel
+// (x, y) is at y·stride + x, and columns x ∈ [−2·step, w + 2·step) are readable (zeros outside
+// the image). `inside[x]` is 1 for x ∈ [0, w), else 0, over the same columns.
 struct AtrousLevelInputs {
   int w = 0, h = 0, step = 1;
-  size_t stride = 0;
+  ptrdiff_t stride = 0;
+  const float* inside;
   const float *z, *gx, *gy, *nx, *ny, *nz, *hasNormal;   // guide
   const float *luminance, *inverseTolerance, *variance;  // this level's luminance statistics
   const float* color[3];
@@ -25,41 +28,90 @@ struct AtrousLevelInputs {
 // Filters one row of a level: (inputs, y, output colour planes, output variance plane).
 using AtrousRowFilter = void (*)(const AtrousLevelInputs&, int, float* const[3], float*);
 
-// The AVX2 row filters (atrous_avx2.cpp); nullptr where they were not compiled.
+// The AVX2 / AVX-512F row filters (atrous_avx2.cpp, atrous_avx512.cpp); nullptr where they
+// were not compiled.
 AtrousRowFilter selectAtrousRowFilterAvx2(int squarings, bool unknownNormals);
+AtrousRowFilter selectAtrousRowFilterAvx512(int squarings, bool unknownNormals);
 
 namespace {
+
+// Two independent vectors behind one type: every operation issues two independent
+// instructions, which hides the latency of the long dependency chain of each tap (the
+// exponential's polynomial, the normal weight's squarings). Defined here, not in
+// float_lanes.h, so that it is compiled with the instruction set of the including file.
+template <class F>
+struct Pair {
+  static constexpr int kWidth = 2 * F::kWidth;
+  F a, b;
+  static Pair load(const float* p) { return {F::load(p), F::load(p + F::kWidth)}; }
+  static Pair broadcast(float x) { return {F::broadcast(x), F::broadcast(x)}; }
+  void store(float* p) const {
+    a.store(p);
+    b.store(p + F::kWidth);
+  }
+};
+template <class F>
+Pair<F> operator+(Pair<F> x, Pair<F> y) {
+  return {x.a + y.a, x.b + y.b};
+}
+template <class F>
+Pair<F> operator-(Pair<F> x, Pair<F> y) {
+  return {x.a - y.a, x.b - y.b};
+}
+template <class F>
+Pair<F> operator*(Pair<F> x, Pair<F> y) {
+  return {x.a * y.a, x.b * y.b};
+}
+template <class F>
+Pair<F> operator/(Pair<F> x, Pair<F> y) {
+  return {x.a / y.a, x.b / y.b};
+}
+template <class F>
+Pair<F> abs(Pair<F> x) {
+  return {abs(x.a), abs(x.b)};
+}
+template <class F>
+Pair<F> max0(Pair<F> x) {
+  return {max0(x.a), max0(x.b)};
+}
+template <class F>
+Pair<F> expNegated(Pair<F> x) {
+  return {expNegated(x.a), expNegated(x.b)};
+}
 
 constexpr std::array<float, 5> kB3Spline = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};
 constexpr float kDepthEpsilon = 1e-3f;  // on depth / max depth
 
 // Filters F::kWidth consecutive pixels from (x, y) with the weights of the header. kBorder:
-// check every tap against the image (else the caller guarantees all taps are inside
-// horizontally). kSquarings: log2 σ_n, or −1 without the normal weight. kUnknownNormals: the
-// guide has pixels without a normal.
+// some tap may lie left or right of the image: its weight is multiplied by inside[qx] = 0 (the
+// padding it reads is zero, so the products stay finite), which leaves every sum exactly as if
+// the tap were skipped. kSquarings: log2 σ_n, or −1 without the normal weight.
+// kUnknownNormals: the guide has pixels without a normal.
 template <class F, bool kBorder, int kSquarings, bool kUnknownNormals>
 void filterPixels(const AtrousLevelInputs& in, int x, int y, float* const outColor[3],
                   float* outVariance) {
-  const size_t p = size_t(y) * in.stride + size_t(x);
+  const ptrdiff_t p = ptrdiff_t(y) * in.stride + x;
   const F zp = F::load(in.z + p), lp = F::load(in.luminance + p);
   const F gx = F::load(in.gx + p), gy = F::load(in.gy + p);
   const F tolerance = F::load(in.inverseTolerance + p);
   const F one = F::broadcast(1.0f);
   const F epsilon = F::broadcast(kDepthEpsilon);
+  // ∇z·δ for δ = step·(tx, ty) as the sum of an x and a y term, taken from these tables.
+  const F zero = F::broadcast(0.0f), stepGx = gx * F::broadcast(float(in.step));
+  const F stepGy = gy * F::broadcast(float(in.step));
+  const F xTerm[5] = {zero - (stepGx + stepGx), zero - stepGx, zero, stepGx, stepGx + stepGx};
+  const F yTerm[5] = {zero - (stepGy + stepGy), zero - stepGy, zero, stepGy, stepGy + stepGy};
   F sum[3] = {F::broadcast(0), F::broadcast(0), F::broadcast(0)};
   F weightSum = F::broadcast(0), varianceSum = F::broadcast(0);
   for (int ty = -2; ty <= 2; ++ty) {
     const int qy = y + ty * in.step;
     if (qy < 0 || qy >= in.h) continue;
-    const F oy = F::broadcast(float(ty * in.step));
     for (int tx = -2; tx <= 2; ++tx) {
       const int qx = x + tx * in.step;
-      if (kBorder && (qx < 0 || qx >= in.w)) continue;
-      const size_t q = size_t(qy) * in.stride + size_t(qx);
-      const F ox = F::broadcast(float(tx * in.step));
+      const ptrdiff_t q = ptrdiff_t(qy) * in.stride + qx;
       const F kernel = F::broadcast(kB3Spline[size_t(tx + 2)] * kB3Spline[size_t(ty + 2)]);
       // w_z w_l = exp(−|Δz| / (σ_z |∇z·δ| + ε_z) − |Δl| / (σ_l √Var + ε_l)); σ_z is in ∇z.
-      const F depthScale = abs(gx * ox + gy * oy) + epsilon;
+      const F depthScale = abs(xTerm[tx + 2] + yTerm[ty + 2]) + epsilon;
       const F e = abs(zp - F::load(in.z + q)) / depthScale +
                   abs(lp - F::load(in.luminance + q)) * tolerance;
       F w = kernel * expNegated(e);
@@ -77,6 +129,7 @@ void filterPixels(const AtrousLevelInputs& in, int x, int y, float* const outCol
         }
         w = w * wn;
       }
+      if constexpr (kBorder) w = w * F::load(in.inside + qx);
       weightSum = weightSum + w;
       varianceSum = varianceSum + w * w * F::load(in.variance + q);
       for (int c = 0; c < 3; ++c) sum[c] = sum[c] + w * F::load(in.color[c] + q);
@@ -87,18 +140,19 @@ void filterPixels(const AtrousLevelInputs& in, int x, int y, float* const outCol
   (varianceSum / (weightSum * weightSum)).store(outVariance + p);
 }
 
-// Filters row y: borders one pixel at a time, the interior Wide::kWidth pixels at a time, and
-// what is left of it one pixel at a time.
+// Filters row y in chunks of Wide::kWidth pixels (masked near the borders), the last few
+// pixels one at a time.
 template <class Wide, int kSquarings, bool kUnknownNormals>
 void filterRow(const AtrousLevelInputs& in, int y, float* const outColor[3], float* outVariance) {
+  const FlushDenormals flush;
   const int margin = 2 * in.step;  // pixels in [margin, w − margin) have all taps inside
   int x = 0;
-  for (; x < std::min(margin, in.w); ++x)
-    filterPixels<Float1, true, kSquarings, kUnknownNormals>(in, x, y, outColor, outVariance);
-  for (; x + Wide::kWidth <= in.w - margin; x += Wide::kWidth)
-    filterPixels<Wide, false, kSquarings, kUnknownNormals>(in, x, y, outColor, outVariance);
-  for (; x < in.w - margin; ++x)
-    filterPixels<Float1, false, kSquarings, kUnknownNormals>(in, x, y, outColor, outVariance);
+  for (; x + Wide::kWidth <= in.w; x += Wide::kWidth) {
+    if (x < margin || x + Wide::kWidth > in.w - margin)
+      filterPixels<Wide, true, kSquarings, kUnknownNormals>(in, x, y, outColor, outVariance);
+    else
+      filterPixels<Wide, false, kSquarings, kUnknownNormals>(in, x, y, outColor, outVariance);
+  }
   for (; x < in.w; ++x)
     filterPixels<Float1, true, kSquarings, kUnknownNormals>(in, x, y, outColor, outVariance);
 }

@@ -14,6 +14,7 @@
 
 #include "denoise/base/input_planes.h"
 #include "denoise/util/fast_exp.h"
+#include "denoise/util/float_lanes.h"
 
 namespace chorus {
 
@@ -170,6 +171,7 @@ void runPass(const PassInput& in, PassOutput& out) {
 
   tbb::parallel_for(
       tbb::blocked_range<int>(0, h * tilesPerRow), [&](const tbb::blocked_range<int>& tiles) {
+        const FlushDenormals flush;  // tiny weights × the spatial Gaussian would be denormal
         Scratch s;
         s.exponent.resize(kTileWidth);
         s.weight.resize(kTileWidth);

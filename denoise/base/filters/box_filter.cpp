@@ -3,77 +3,126 @@
 #include <algorithm>
 
 #include "denoise/base/filters/planar_image.h"
+#include "denoise/base/filters/simd_quad.h"
 
 namespace chorus {
 namespace {
 
 // Radii up to this sum their taps directly; beyond, running sums are cheaper.
-constexpr int kMaxDirectRadius = 4;
+constexpr int kMaxDirectRadius = 4;  // also the largest kernel instantiated below
 
-// out[i] = mean of in[j] for j in [i - r, i + r] ∩ [0, n).
-void boxRowDirect(const float* in, float* out, int n, int r) {
-  const float inv = 1.0f / float(2 * r + 1);
-  const int interiorBegin = std::min(r, n), interiorEnd = std::max(interiorBegin, n - r);
-  // Taps in ascending order for every pixel (also the clipped ones below), x innermost so that
-  // the loop vectorises.
-  for (int x = interiorBegin; x < interiorEnd; ++x) out[x] = in[x - r];
-  for (int j = -r + 1; j <= r; ++j)
-    for (int x = interiorBegin; x < interiorEnd; ++x) out[x] += in[x + j];
-  for (int x = interiorBegin; x < interiorEnd; ++x) out[x] *= inv;
-  auto clipped = [&](int x) {
-    const int a = std::max(0, x - r), b = std::min(n - 1, x + r);
-    float s = 0.0f;
-    for (int j = a; j <= b; ++j) s += in[j];
-    out[x] = s / float(b - a + 1);
-  };
-  for (int x = 0; x < interiorBegin; ++x) clipped(x);
-  for (int x = interiorEnd; x < n; ++x) clipped(x);
+int roundUp4(int n) { return (n + 3) / 4 * 4; }
+
+// 1 / (true count) of the clipped box along an axis of length n, padded to a multiple of 4.
+void inverseCounts(int n, int r, std::vector<float>& inv) {
+  inv.assign(size_t(roundUp4(n)), 0.0f);
+  for (int x = 0; x < n; ++x)
+    inv[size_t(x)] = 1.0f / float(std::min(n - 1, x + r) - std::max(0, x - r) + 1);
 }
 
-void boxRowRunning(const float* in, float* out, int n, int r) {
-  double s = 0.0;
-  for (int j = 0; j < std::min(r, n); ++j) s += in[j];
-  for (int x = 0; x < n; ++x) {
-    if (x + r < n) s += in[x + r];
-    const int a = std::max(0, x - r), b = std::min(n - 1, x + r);
-    out[x] = float(s / double(b - a + 1));
-    if (x - r >= 0) s -= in[x - r];
+// Sums of 2R + 1 taps for one row: `padded` holds the row between R zeros on either side (adding
+// the zeros is exact, so clipped and interior pixels sum their taps the same way, in ascending
+// order); out[x] = sum · invCount[x], written four at a time (room for roundUp4(n) values).
+template <int R>
+void boxRowDirect(const float* padded, float* out, int n, const float* invCount) {
+  for (int x = 0; x < n; x += 4) {
+    Quad acc = loadQuad(padded + x);
+    for (int j = 1; j <= 2 * R; ++j) acc += loadQuad(padded + x + j);
+    storeQuad(out + x, acc * loadQuad(invCount + x));
   }
 }
 
-}  // namespace
+// out[x] = inv · Σ_{j < N} rows[j · stride + x] for x < vectorEnd (a multiple of 4).
+template <int N>
+void columnSum(const float* rows, size_t stride, float inv, float* out, int vectorEnd) {
+  for (int x = 0; x < vectorEnd; x += 4) {
+    Quad acc = loadQuad(rows + x);
+    for (int j = 1; j < N; ++j) acc += loadQuad(rows + size_t(j) * stride + size_t(x));
+    storeQuad(out + x, acc * splatQuad(inv));
+  }
+}
 
-void boxFilterPlane(const float* src, float* dst, int width, int height, int radius,
-                    std::vector<float>& tmp) {
-  if (width <= 0 || height <= 0) return;
+void columnSumAny(const float* rows, size_t stride, int n, float inv, float* out, int vectorEnd) {
+  switch (n) {
+    case 1: return columnSum<1>(rows, stride, inv, out, vectorEnd);
+    case 2: return columnSum<2>(rows, stride, inv, out, vectorEnd);
+    case 3: return columnSum<3>(rows, stride, inv, out, vectorEnd);
+    case 4: return columnSum<4>(rows, stride, inv, out, vectorEnd);
+    case 5: return columnSum<5>(rows, stride, inv, out, vectorEnd);
+    case 6: return columnSum<6>(rows, stride, inv, out, vectorEnd);
+    case 7: return columnSum<7>(rows, stride, inv, out, vectorEnd);
+    case 8: return columnSum<8>(rows, stride, inv, out, vectorEnd);
+    default: return columnSum<9>(rows, stride, inv, out, vectorEnd);
+  }
+}
+
+void boxRowAny(const float* padded, float* out, int n, int r, const float* invCount) {
+  switch (r) {
+    case 1: return boxRowDirect<1>(padded, out, n, invCount);
+    case 2: return boxRowDirect<2>(padded, out, n, invCount);
+    case 3: return boxRowDirect<3>(padded, out, n, invCount);
+    default: return boxRowDirect<4>(padded, out, n, invCount);
+  }
+}
+
+// Small radii: direct taps, exact and independent of where the plane starts. Computes the crop
+// only: the row pass covers the crop's columns on every row the column pass reads.
+void boxFilterDirect(const float* src, int width, int height, int radius, const PixelRect& crop,
+                     float* dst, std::vector<float>& tmp) {
+  const int cw = crop.width();
+  const int rowBegin = std::max(0, crop.y0 - radius), rowEnd = std::min(height, crop.y1 + radius);
+  // The columns the row pass reads, with zeros where they fall outside the plane.
+  const int readBegin = crop.x0 - radius, readWidth = cw + 2 * radius;
+  const size_t stride = size_t(roundUp4(cw));
+  const size_t paddedSize = size_t(roundUp4(readWidth) + 4);
+  thread_local std::vector<float> invX, invY;
+  invX.assign(stride, 0.0f);
+  for (int x = 0; x < cw; ++x) {
+    const int px = crop.x0 + x;
+    invX[size_t(x)] = 1.0f / float(std::min(width - 1, px + radius) - std::max(0, px - radius) + 1);
+  }
+  inverseCounts(height, radius, invY);
+  tmp.resize(stride * size_t(rowEnd - rowBegin) + paddedSize);
+  float* padded = tmp.data() + stride * size_t(rowEnd - rowBegin);
+  std::fill(padded, padded + paddedSize, 0.0f);
+  const int copyBegin = std::max(0, readBegin), copyEnd = std::min(width, readBegin + readWidth);
+  for (int y = rowBegin; y < rowEnd; ++y) {
+    const float* row = src + size_t(y) * size_t(width);
+    std::copy(row + copyBegin, row + copyEnd, padded + (copyBegin - readBegin));
+    boxRowAny(padded, tmp.data() + size_t(y - rowBegin) * stride, cw, radius, invX.data());
+  }
+  // Column pass: each output row is the mean of the clipped run of row means.
+  const int vectorEnd = cw / 4 * 4;
+  for (int y = crop.y0; y < crop.y1; ++y) {
+    const int a = std::max(0, y - radius), b = std::min(height - 1, y + radius);
+    const float inv = invY[size_t(y)];
+    float* out = dst + size_t(y - crop.y0) * size_t(cw);
+    const float* first = tmp.data() + size_t(a - rowBegin) * stride;
+    columnSumAny(first, stride, b - a + 1, inv, out, vectorEnd);
+    for (int x = vectorEnd; x < cw; ++x) {
+      float acc = first[x];
+      for (int j = 1; j <= b - a; ++j) acc += first[size_t(j) * stride + size_t(x)];
+      out[x] = acc * inv;
+    }
+  }
+}
+
+// Large radii: running sums in double precision (no drift over long rows).
+void boxFilterRunning(const float* src, float* dst, int width, int height, int radius,
+                      std::vector<float>& tmp) {
   const size_t w = size_t(width);
   tmp.resize(w * size_t(height));
-  if (radius <= 0) {
-    if (dst != src) std::copy(src, src + w * size_t(height), dst);
-    return;
-  }
-  // Row pass into tmp.
   for (int y = 0; y < height; ++y) {
-    if (radius <= kMaxDirectRadius)
-      boxRowDirect(src + size_t(y) * w, tmp.data() + size_t(y) * w, width, radius);
-    else
-      boxRowRunning(src + size_t(y) * w, tmp.data() + size_t(y) * w, width, radius);
-  }
-  // Column pass: each output row is the mean of the clipped run of tmp rows.
-  if (radius <= kMaxDirectRadius) {
-    for (int y = 0; y < height; ++y) {
-      const int a = std::max(0, y - radius), b = std::min(height - 1, y + radius);
-      const float inv = 1.0f / float(b - a + 1);
-      float* out = dst + size_t(y) * w;
-      const float* first = tmp.data() + size_t(a) * w;
-      for (size_t x = 0; x < w; ++x) out[x] = first[x];
-      for (int j = a + 1; j <= b; ++j) {
-        const float* in = tmp.data() + size_t(j) * w;
-        for (size_t x = 0; x < w; ++x) out[x] += in[x];
-      }
-      for (size_t x = 0; x < w; ++x) out[x] *= inv;
+    const float* in = src + size_t(y) * w;
+    float* out = tmp.data() + size_t(y) * w;
+    double s = 0.0;
+    for (int j = 0; j < std::min(radius, width); ++j) s += in[j];
+    for (int x = 0; x < width; ++x) {
+      if (x + radius < width) s += in[x + radius];
+      const int a = std::max(0, x - radius), b = std::min(width - 1, x + radius);
+      out[x] = float(s / double(b - a + 1));
+      if (x - radius >= 0) s -= in[x - radius];
     }
-    return;
   }
   std::vector<double> sums(w, 0.0);
   for (int j = 0; j < std::min(radius, height); ++j)
@@ -89,11 +138,51 @@ void boxFilterPlane(const float* src, float* dst, int width, int height, int rad
   }
 }
 
+}  // namespace
+
+void boxFilterCrop(const float* src, int width, int height, int radius, const PixelRect& crop,
+                   float* dst, std::vector<float>& tmp) {
+  if (crop.empty()) return;
+  if (radius <= 0) {
+    for (int y = crop.y0; y < crop.y1; ++y)
+      std::copy(src + size_t(y) * size_t(width) + size_t(crop.x0),
+                src + size_t(y) * size_t(width) + size_t(crop.x1),
+                dst + size_t(y - crop.y0) * size_t(crop.width()));
+    return;
+  }
+  if (radius <= kMaxDirectRadius) {
+    boxFilterDirect(src, width, height, radius, crop, dst, tmp);
+    return;
+  }
+  std::vector<float> whole(size_t(width) * size_t(height));
+  boxFilterRunning(src, whole.data(), width, height, radius, tmp);
+  for (int y = crop.y0; y < crop.y1; ++y)
+    std::copy(whole.data() + size_t(y) * size_t(width) + size_t(crop.x0),
+              whole.data() + size_t(y) * size_t(width) + size_t(crop.x1),
+              dst + size_t(y - crop.y0) * size_t(crop.width()));
+}
+
+void boxFilterPlane(const float* src, float* dst, int width, int height, int radius,
+                    std::vector<float>& tmp) {
+  if (width <= 0 || height <= 0) return;
+  if (radius <= 0) {
+    if (dst != src) std::copy(src, src + size_t(width) * size_t(height), dst);
+    return;
+  }
+  if (radius <= kMaxDirectRadius) {
+    // The row pass goes to tmp before the column pass writes dst, so src may be dst.
+    boxFilterDirect(src, width, height, radius, PixelRect::image(width, height), dst, tmp);
+    return;
+  }
+  boxFilterRunning(src, dst, width, height, radius, tmp);
+}
+
 Image boxFilter(const Image& image, int radius) {
   PlanarImage planes(image);
   std::vector<float> tmp;
   for (int c = 0; c < planes.channels(); ++c)
-    boxFilterPlane(planes.plane(c), planes.plane(c), planes.width(), planes.height(), radius, tmp);
+    boxFilterPlane(planes.plane(c), planes.plane(c), planes.width(), planes.height(), radius,
+                   tmp);
   return planes.toImage();
 }
 

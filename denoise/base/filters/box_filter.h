@@ -6,6 +6,7 @@
 // sums.
 #include <vector>
 
+#include "denoise/base/filters/pixel_rect.h"
 #include "denoise/image/image.h"
 
 namespace chorus {
@@ -14,6 +15,12 @@ namespace chorus {
 // the same buffer. `tmp` is scratch, resized as needed.
 void boxFilterPlane(const float* src, float* dst, int width, int height, int radius,
                     std::vector<float>& tmp);
+
+// The box filter of a width × height plane evaluated only on `crop` (a rectangle inside the
+// plane, in its coordinates), written as a crop.width() × crop.height() plane to dst; the
+// clipping and counts are those of the whole plane. dst must not overlap src.
+void boxFilterCrop(const float* src, int width, int height, int radius, const PixelRect& crop,
+                   float* dst, std::vector<float>& tmp);
 
 // Every channel of `image` box-filtered with the given radius.
 Image boxFilter(const Image& image, int radius);

@@ -8,14 +8,6 @@
 #include "denoise/base/filters/fast_exp.h"
 
 namespace chorus {
-namespace {
-
-float weightOfDistance(float d) {
-  return expNonPositive(-std::max(0.0f, d));
-}
-
-}  // namespace
-
 NlMeansWeights::NlMeansWeights(std::span<const NlMeansTerm> terms, const NlMeansParams& params)
     : params_(params) {
   if (terms.empty()) throw std::invalid_argument("NlMeansWeights: no terms");
@@ -143,15 +135,10 @@ void NlMeansWeights::termPatchDistance(const PreparedTerm& t, const PixelRect& r
   scratch.pixelDistance.resize(eArea * size_t(planes));
   pixelDistances(t, e, dx, dy, average, symmetric, scratch.pixelDistance.data());
   const size_t rArea = size_t(region.area());
-  const int rw = region.width();
-  for (int c = 0; c < planes; ++c) {
-    float* plane = scratch.pixelDistance.data() + size_t(c) * eArea;
-    boxFilterPlane(plane, plane, e.width(), e.height(), t.f, scratch.boxTmp);
-    for (int y = region.y0; y < region.y1; ++y) {
-      const float* src = plane + size_t(y - e.y0) * size_t(e.width()) + (region.x0 - e.x0);
-      std::copy(src, src + rw, out + size_t(c) * rArea + size_t(y - region.y0) * size_t(rw));
-    }
-  }
+  const PixelRect crop = region.shifted(-e.x0, -e.y0);
+  for (int c = 0; c < planes; ++c)
+    boxFilterCrop(scratch.pixelDistance.data() + size_t(c) * eArea, e.width(), e.height(), t.f,
+                  crop, out + size_t(c) * rArea, scratch.boxTmp);
 }
 
 void NlMeansWeights::patchDistance(int term, const PixelRect& region, int dx, int dy,
@@ -164,22 +151,26 @@ void NlMeansWeights::patchDistance(int term, const PixelRect& region, int dx, in
 
 void NlMeansWeights::termWeights(const PreparedTerm& t, const float* distance, size_t area,
                                  float* out) const {
+  // First −min(max(0, D), kMaxExpArgument) (weights are exp of it), then the exponential, in
+  // separate loops so that both vectorise.
+  const int channels = t.guide.channels();
   switch (t.channels) {
     case ChannelWeights::PerChannel:
-      for (size_t i = 0; i < area * size_t(t.guide.channels()); ++i)
-        out[i] = weightOfDistance(distance[i]);
+      for (size_t i = 0; i < area * size_t(channels); ++i)
+        out[i] = -std::min(std::max(distance[i], 0.0f), kMaxExpArgument);
+      expNonPositiveInPlace(out, area * size_t(channels));
       break;
     case ChannelWeights::MinOverChannels:
       // min_c exp(−max(0, D_c)) = exp(−max(0, max_c D_c))
-      for (size_t i = 0; i < area; ++i) {
-        float d = distance[i];
-        for (int c = 1; c < t.guide.channels(); ++c)
-          d = std::max(d, distance[size_t(c) * area + i]);
-        out[i] = weightOfDistance(d);
-      }
+      for (size_t i = 0; i < area; ++i) out[i] = distance[i];
+      for (int c = 1; c < channels; ++c)
+        for (size_t i = 0; i < area; ++i) out[i] = std::max(out[i], distance[size_t(c) * area + i]);
+      for (size_t i = 0; i < area; ++i) out[i] = -std::min(std::max(out[i], 0.0f), kMaxExpArgument);
+      expNonPositiveInPlace(out, area);
       break;
     case ChannelWeights::AverageDistance:
-      for (size_t i = 0; i < area; ++i) out[i] = weightOfDistance(distance[i]);
+      for (size_t i = 0; i < area; ++i) out[i] = -std::min(std::max(distance[i], 0.0f), kMaxExpArgument);
+      expNonPositiveInPlace(out, area);
       break;
   }
 }

@@ -1,0 +1,58 @@
+#pragma once
+// NFOR — nonlinearly weighted first-order regression (Bitterli, Rousselle, Moon, Iglesias-Guitián,
+// Adler, Mitchell, Jarosz, Novák; Computer Graphics Forum / EGSR 2016), step by step as in the
+// first author's own implementation in Tungsten (src/denoiser/denoiser.cpp), summarised in
+// base-denoisers.md §2:
+//   1. feature cross-prefiltering: each half's features NL-means filtered with weights from the
+//      other half (§5.1);
+//   2. collaborative first-order regression of each half's colour on the other half's filtered
+//      features, with NL-means weights from the other half's colour, for two bandwidths k (§5.2);
+//   3. a dual-buffer MSE estimate per bandwidth, NL-means smoothed; a per-channel selection map,
+//      smoothed the same way, blends the two bandwidths (§5.3);
+//   4. a second regression of the blended halves' mean on the re-filtered mean features (§5.4).
+// Features, in Tungsten's order: depth, albedo R G B, normal x y z, visibility.
+// Deviations from Tungsten (see README): a Gram-matrix solver with rank-revealing pivoting
+// instead of Eigen's column-pivoted QR on the window matrix (same fitted values for full-rank
+// windows), float sums in other orders; nothing else.
+#include "denoise/base/base_denoiser.h"
+#include "denoise/base/param_map.h"
+
+namespace chorus {
+
+// Parameters of NFOR: the values of Tungsten's implementation. f: patch radius, r: window
+// radius, k: NL-means sensitivity (bandwidth) — the symbols of base-denoisers.md §0.
+struct NforParams {
+  // 1. Feature cross-prefilter (per channel, guide = the other half, variance scale 2).
+  int prefilterF = 3, prefilterR = 5;
+  float prefilterK = 0.5f;
+  // 2. Regression: patch, window and the two candidate bandwidths.
+  int regressionF = 3, regressionR = 9;
+  float k1 = 0.5f, k2 = 1.0f;
+  // 3. MSE and selection-map smoothing (per channel, guide = the whole input's colour).
+  int mseF = 1, mseR = 9;
+  float mseK = 1.0f;
+  // 4. Second pass: final feature filter and final regression.
+  int finalFeatureF = 3, finalFeatureR = 2;
+  float finalFeatureK = 0.5f;
+  int finalF = 3, finalR = 9;
+  float finalK = 1.0f;
+  // NL-means constants of Tungsten's nlMeansWeights.
+  float epsilon = 1e-7f, distanceClamp = 1e4f, minCenterWeight = 1e-4f;
+
+  // Reads overrides (keys = the field names above); unread keys stay in the map.
+  static NforParams fromParams(ParamMap& map);
+};
+
+class NforDenoiser : public BaseDenoiser {
+ public:
+  explicit NforDenoiser(const NforParams& params = {}) : params_(params) {}
+  std::string name() const override { return "nfor"; }
+  DenoiserRequirements requirements() const override { return {.features = true, .halves = true}; }
+  // Throws chorus::Error when the input has no halves.
+  Image run(const DenoiseInput& input) const override;
+
+ private:
+  NforParams params_;
+};
+
+}  // namespace chorus

@@ -70,9 +70,9 @@ TEST(GramSolver, RankDeficientColumnsGiveTheSameFitWithoutBlowingUp) {
   for (int i = 0; i < n; ++i) {
     X(i, 0) = 1;
     X(i, 1) = u(rng);
-    X(i, 2) = 0;                 // a constant (zero) feature difference
-    X(i, 3) = X(i, 1);           // a duplicated feature
-    X(i, 4) = -3.0 * X(i, 1);    // a scaled copy
+    X(i, 2) = 0;               // a constant (zero) feature difference
+    X(i, 3) = X(i, 1);         // a duplicated feature
+    X(i, 4) = -3.0 * X(i, 1);  // a scaled copy
     X(i, 5) = u(rng);
     for (int c = 0; c < C; ++c) Y(i, c) = u(rng);
     w(i) = pos(rng);
@@ -124,11 +124,15 @@ Scene affineScene(int w, int h, int m, uint32_t seed) {
 }
 
 NlMeansWeights regressionWeights(const Scene& s, int r, float k = 1.0f) {
-  return NlMeansWeights(
-      NlMeansTerm{.guide = &s.guide, .variance = &s.variance, .f = 2, .k = k, .s = 2.0f,
-                  .epsilon = 1e-7f, .distanceClamp = 1e4f,
-                  .channels = ChannelWeights::MinOverChannels},
-      NlMeansParams{.r = r, .minCenterWeight = 1e-4f});
+  return NlMeansWeights(NlMeansTerm{.guide = &s.guide,
+                                    .variance = &s.variance,
+                                    .f = 2,
+                                    .k = k,
+                                    .s = 2.0f,
+                                    .epsilon = 1e-7f,
+                                    .distanceClamp = 1e4f,
+                                    .channels = ChannelWeights::MinOverChannels},
+                        NlMeansParams{.r = r, .minCenterWeight = 1e-4f});
 }
 
 void expectRelativeNear(const Image& got, const Image& want, double tol) {
@@ -176,8 +180,8 @@ TEST(CollaborativeRegression, ZeroVarianceGuideKeepsEveryPixel) {
 
 // Brute force: every window's weighted least squares with Eigen's pivoted QR in double,
 // predictions accumulated with their weights (Regression.cpp's algorithm).
-Image bruteForceRegression(const Image& image, const Image& features,
-                           const NlMeansWeights& weights, const Scene& s, int r) {
+Image bruteForceRegression(const Image& image, const Image& features, const NlMeansWeights& weights,
+                           const Scene& s, int r) {
   const int w = image.width(), h = image.height(), m = features.channels(), d = 3 + m;
   // The weights w(p, q) from the same machinery (tested against its own brute force).
   NlMeansScratch scratch;

@@ -91,8 +91,7 @@ Image featureVariances(const DenoiseInput& input) {
       for (int y = 0; y < out.height(); ++y)
         for (int x = 0; x < out.width(); ++x) {
           const bool known = std::isfinite(m1(x, y, c)) && std::isfinite(m2(x, y, c));
-          out(x, y, channel) =
-              known ? variance(x, y, c) : std::numeric_limits<float>::quiet_NaN();
+          out(x, y, channel) = known ? variance(x, y, c) : std::numeric_limits<float>::quiet_NaN();
         }
   }
   return out;
@@ -150,21 +149,22 @@ class NforRun {
                                    window(p_.mseR));
     const Image* mses[] = {&mse[0], &mse[1]};
     const NlMeansFilterResult smoothed = nlMeansFilterAll(mses, smoothing);
-    const Image noisySelection =
-        combine(smoothed.filtered[0], smoothed.filtered[1],
-                [](float e1, float e2) { return e1 < e2 ? 0.0f : 1.0f; });
+    const Image noisySelection = combine(smoothed.filtered[0], smoothed.filtered[1],
+                                         [](float e1, float e2) { return e1 < e2 ? 0.0f : 1.0f; });
     const Image selection = nlMeansFilter(noisySelection, smoothing);
     const Image r1 = blend(y1[0], y1[1], selection), r2 = blend(y2[0], y2[1], selection);
 
     // Second filter pass (§5.4) on the means of the halves, with their dual-buffer variances.
-    const Image fMean = combine(f1Filtered, f2Filtered, [](float a, float b) { return (a + b) * 0.5f; });
+    const Image fMean =
+        combine(f1Filtered, f2Filtered, [](float a, float b) { return (a + b) * 0.5f; });
     const Image fMeanVar =
         combine(f1Filtered, f2Filtered, [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
     const Image fFinal =
         nlMeans(fMean, perChannelTerm(fMean, fMeanVar, p_.finalFeatureF, p_.finalFeatureK, 1.0f),
                 window(p_.finalFeatureR));
     const Image rMean = combine(r1, r2, [](float a, float b) { return (a + b) * 0.5f; });
-    const Image rMeanVar = combine(r1, r2, [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
+    const Image rMeanVar =
+        combine(r1, r2, [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
     Image out = regress(rMean, fFinal, rMean, rMeanVar, p_.finalF, p_.finalK, p_.finalR);
 
     for (size_t i = 0; i < out.size(); ++i)
@@ -179,8 +179,14 @@ class NforRun {
 
   NlMeansTerm perChannelTerm(const Image& guide, const Image& variance, int f, float k,
                              float s) const {
-    return {.guide = &guide, .variance = &variance, .f = f, .k = k, .alpha = 1.0f, .s = s,
-            .epsilon = p_.epsilon, .distanceClamp = p_.distanceClamp,
+    return {.guide = &guide,
+            .variance = &variance,
+            .f = f,
+            .k = k,
+            .alpha = 1.0f,
+            .s = s,
+            .epsilon = p_.epsilon,
+            .distanceClamp = p_.distanceClamp,
             .channels = ChannelWeights::PerChannel};
   }
 
@@ -189,8 +195,14 @@ class NforRun {
   // where it is kept for fidelity.
   Image regress(const Image& image, const Image& features, const Image& guide,
                 const Image& variance, int f, float k, int r) const {
-    const NlMeansTerm term{.guide = &guide, .variance = &variance, .f = f, .k = k, .alpha = 1.0f,
-                           .s = 2.0f, .epsilon = p_.epsilon, .distanceClamp = p_.distanceClamp,
+    const NlMeansTerm term{.guide = &guide,
+                           .variance = &variance,
+                           .f = f,
+                           .k = k,
+                           .alpha = 1.0f,
+                           .s = 2.0f,
+                           .epsilon = p_.epsilon,
+                           .distanceClamp = p_.distanceClamp,
                            .channels = ChannelWeights::MinOverChannels};
     return collaborativeRegression(image, features, NlMeansWeights(term, window(r)));
   }

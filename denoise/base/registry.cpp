@@ -4,6 +4,8 @@
 
 #include "denoise/base/atrous.h"
 #include "denoise/base/bilateral.h"
+#include "denoise/base/dual_buffer_nlm.h"
+#include "denoise/base/nfor.h"
 #include "denoise/base/sbf.h"
 
 #include "denoise/util/error.h"
@@ -13,6 +15,16 @@ namespace chorus {
 const std::vector<DenoiserEntry>& builtinDenoisers() {
   // Each denoiser's file provides its entry; add new ones here, in the order `--help` lists them.
   static const std::vector<DenoiserEntry> entries = {
+      {"nfor",
+       "NFOR: first-order regression on features with NL-means weights (Bitterli et al. 2016, as "
+       "in Tungsten); needs halves",
+       [](ParamMap& p) { return std::make_unique<NforDenoiser>(NforParams::fromParams(p)); }},
+      {"nlm",
+       "NL-means with dual-buffer variance, cross-filtered halves (Rousselle et al. 2012); needs "
+       "halves",
+       [](ParamMap& p) {
+         return std::make_unique<DualBufferNlMeans>(DualBufferNlMeansParams::fromParams(p));
+       }},
       {"sbf", "SURE-based selection among feature-guided cross-bilateral filters (Li et al. 2012)",
        [](ParamMap& p) { return std::make_unique<Sbf>(SbfParams::fromParams(p)); }},
       {"atrous",

@@ -11,7 +11,9 @@ namespace {
 // Radii up to this sum their taps directly; beyond, running sums are cheaper.
 constexpr int kMaxDirectRadius = 4;  // also the largest kernel instantiated below
 
-int roundUp4(int n) { return (n + 3) / 4 * 4; }
+int roundUp4(int n) {
+  return (n + 3) / 4 * 4;
+}
 
 // 1 / (true count) of the clipped box along an axis of length n, padded to a multiple of 4.
 void inverseCounts(int n, int r, std::vector<float>& inv) {
@@ -44,24 +46,37 @@ void columnSum(const float* rows, size_t stride, float inv, float* out, int vect
 
 void columnSumAny(const float* rows, size_t stride, int n, float inv, float* out, int vectorEnd) {
   switch (n) {
-    case 1: return columnSum<1>(rows, stride, inv, out, vectorEnd);
-    case 2: return columnSum<2>(rows, stride, inv, out, vectorEnd);
-    case 3: return columnSum<3>(rows, stride, inv, out, vectorEnd);
-    case 4: return columnSum<4>(rows, stride, inv, out, vectorEnd);
-    case 5: return columnSum<5>(rows, stride, inv, out, vectorEnd);
-    case 6: return columnSum<6>(rows, stride, inv, out, vectorEnd);
-    case 7: return columnSum<7>(rows, stride, inv, out, vectorEnd);
-    case 8: return columnSum<8>(rows, stride, inv, out, vectorEnd);
-    default: return columnSum<9>(rows, stride, inv, out, vectorEnd);
+    case 1:
+      return columnSum<1>(rows, stride, inv, out, vectorEnd);
+    case 2:
+      return columnSum<2>(rows, stride, inv, out, vectorEnd);
+    case 3:
+      return columnSum<3>(rows, stride, inv, out, vectorEnd);
+    case 4:
+      return columnSum<4>(rows, stride, inv, out, vectorEnd);
+    case 5:
+      return columnSum<5>(rows, stride, inv, out, vectorEnd);
+    case 6:
+      return columnSum<6>(rows, stride, inv, out, vectorEnd);
+    case 7:
+      return columnSum<7>(rows, stride, inv, out, vectorEnd);
+    case 8:
+      return columnSum<8>(rows, stride, inv, out, vectorEnd);
+    default:
+      return columnSum<9>(rows, stride, inv, out, vectorEnd);
   }
 }
 
 void boxRowAny(const float* padded, float* out, int n, int r, const float* invCount) {
   switch (r) {
-    case 1: return boxRowDirect<1>(padded, out, n, invCount);
-    case 2: return boxRowDirect<2>(padded, out, n, invCount);
-    case 3: return boxRowDirect<3>(padded, out, n, invCount);
-    default: return boxRowDirect<4>(padded, out, n, invCount);
+    case 1:
+      return boxRowDirect<1>(padded, out, n, invCount);
+    case 2:
+      return boxRowDirect<2>(padded, out, n, invCount);
+    case 3:
+      return boxRowDirect<3>(padded, out, n, invCount);
+    default:
+      return boxRowDirect<4>(padded, out, n, invCount);
   }
 }
 
@@ -181,8 +196,7 @@ Image boxFilter(const Image& image, int radius) {
   PlanarImage planes(image);
   std::vector<float> tmp;
   for (int c = 0; c < planes.channels(); ++c)
-    boxFilterPlane(planes.plane(c), planes.plane(c), planes.width(), planes.height(), radius,
-                   tmp);
+    boxFilterPlane(planes.plane(c), planes.plane(c), planes.width(), planes.height(), radius, tmp);
   return planes.toImage();
 }
 

@@ -33,8 +33,8 @@ float weightedDot(const float* w, const float* a, const float* b, int n) {
 }
 
 // Four weighted dot products Σ w·a·b_k sharing w·a.
-void weightedDot4(const float* w, const float* a, const float* b0, const float* b1,
-                  const float* b2, const float* b3, int n, float* out) {
+void weightedDot4(const float* w, const float* a, const float* b0, const float* b1, const float* b2,
+                  const float* b3, int n, float* out) {
   Quad l0 = {}, h0 = {}, l1 = {}, h1 = {}, l2 = {}, h2 = {}, l3 = {}, h3 = {};
   for (int i = 0; i < n; i += kLanes) {
     const Quad lo = loadQuad(w + i) * loadQuad(a + i);
@@ -64,9 +64,9 @@ struct ThreadState {
   NlMeansScratch scratch;
   std::vector<float> table;  // weights [tile pixel][offset]
   std::vector<float> plus, minus, center;
-  std::vector<float> columns;  // (d + C) columns of the compacted window, stride `stride`
+  std::vector<float> columns;      // (d + C) columns of the compacted window, stride `stride`
   std::vector<float> predictions;  // C columns of window predictions
-  std::vector<float> rowWeights;  // w_q of each window row
+  std::vector<float> rowWeights;   // w_q of each window row
 };
 
 class Regression {
@@ -99,9 +99,8 @@ class Regression {
         tiles.push_back({x, y, std::min(width_, x + kTileSize), std::min(height_, y + kTileSize)});
     std::vector<TileResult> results(tiles.size());
     tbb::enumerable_thread_specific<ThreadState> states;
-    tbb::parallel_for(size_t(0), tiles.size(), [&](size_t t) {
-      regressTile(tiles[t], states.local(), results[t]);
-    });
+    tbb::parallel_for(size_t(0), tiles.size(),
+                      [&](size_t t) { regressTile(tiles[t], states.local(), results[t]); });
     return gather(tiles, results);
   }
 
@@ -138,8 +137,7 @@ class Regression {
       for (int px = tile.x0; px < tile.x1; ++px) regressPixel(tile, px, py, st, out);
   }
 
-  void regressPixel(const PixelRect& tile, int px, int py, ThreadState& st,
-                    TileResult& out) const {
+  void regressPixel(const PixelRect& tile, int px, int py, ThreadState& st, TileResult& out) const {
     const size_t area = planeStride(tile);
     const float* w = st.table.data() + size_t(py - tile.y0) * size_t(tile.width()) +
                      size_t(px - tile.x0);  // w_δ(p) = w[offsetIndex(δ) · planeStride]
@@ -208,8 +206,10 @@ class Regression {
     const int total = d_ + channels_;
     for (int a = 0; a < d_; ++a) {
       auto store = [&](int b, float v) {
-        if (b < d_) gram[a * d_ + b] = v;
-        else rhs[a * channels_ + (b - d_)] = v;
+        if (b < d_)
+          gram[a * d_ + b] = v;
+        else
+          rhs[a * channels_ + (b - d_)] = v;
       };
       int b = a;
       for (; b + 4 <= total; b += 4) {
@@ -234,7 +234,8 @@ class Regression {
         const Quad xa = loadQuad(cols + size_t(a) * size_t(stride_) + size_t(i));
         for (int c = 0; c < channels_; ++c) p[c] += splatQuad(b[a][c]) * xa;
       }
-      for (int c = 0; c < channels_; ++c) storeQuad(out + size_t(c) * size_t(stride_) + size_t(i), p[c]);
+      for (int c = 0; c < channels_; ++c)
+        storeQuad(out + size_t(c) * size_t(stride_) + size_t(i), p[c]);
     }
   }
 
@@ -251,8 +252,8 @@ class Regression {
         const PixelRect overlap = tr.extent.intersect(rows);
         for (int y = overlap.y0; y < overlap.y1; ++y)
           for (int x = overlap.x0; x < overlap.x1; ++x) {
-            const size_t src = size_t(y - tr.extent.y0) * size_t(tr.extent.width()) +
-                               size_t(x - tr.extent.x0);
+            const size_t src =
+                size_t(y - tr.extent.y0) * size_t(tr.extent.width()) + size_t(x - tr.extent.x0);
             const size_t dst = size_t(y - rows.y0) * size_t(width_) + size_t(x);
             wsum[dst] += tr.wsum[src];
             for (int c = 0; c < channels_; ++c)

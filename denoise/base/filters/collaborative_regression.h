@@ -18,7 +18,6 @@ namespace chorus {
 // non-finite values are treated as 0; `weights`: scalar weights of the image's size, whose
 // window radius r is the regression window. Throws std::invalid_argument on mismatches.
 Image collaborativeRegression(const Image& image, const Image& features,
-                              const NlMeansWeights& weights,
-                              const GramTolerances& tolerances = {});
+                              const NlMeansWeights& weights, const GramTolerances& tolerances = {});
 
 }  // namespace chorus

@@ -169,7 +169,8 @@ void NlMeansWeights::termWeights(const PreparedTerm& t, const float* distance, s
       expNonPositiveInPlace(out, area);
       break;
     case ChannelWeights::AverageDistance:
-      for (size_t i = 0; i < area; ++i) out[i] = -std::min(std::max(distance[i], 0.0f), kMaxExpArgument);
+      for (size_t i = 0; i < area; ++i)
+        out[i] = -std::min(std::max(distance[i], 0.0f), kMaxExpArgument);
       expNonPositiveInPlace(out, area);
       break;
   }

@@ -14,8 +14,12 @@ inline Quad loadQuad(const float* p) {
   return v;
 }
 
-inline void storeQuad(float* p, Quad v) { std::memcpy(p, &v, sizeof v); }
+inline void storeQuad(float* p, Quad v) {
+  std::memcpy(p, &v, sizeof v);
+}
 
-inline Quad splatQuad(float v) { return Quad{v, v, v, v}; }
+inline Quad splatQuad(float v) {
+  return Quad{v, v, v, v};
+}
 
 }  // namespace chorus

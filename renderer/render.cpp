@@ -47,7 +47,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
       selectCamera(scene, options.camera, float(resolution.width) / float(resolution.height)),
       resolution);
   const LightSet lights(scene);
-  const PathTracer tracer(scene, lights, PathTracerSettings{options.maxDepth, 3});
+  const PathTracer tracer(scene, lights,
+                          PathTracerSettings{options.maxDepth, options.rouletteStartDepth});
   Film film(resolution.width, resolution.height, options.splits);
 
   const int tilesX = (resolution.width + kTileSize - 1) / kTileSize;

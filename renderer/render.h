@@ -27,7 +27,10 @@ struct RenderOptions {
   uint64_t seed = 0;
   int threads = 0;   // 0: all cores
   int maxDepth = 8;  // maximum number of scattering events per path
-  int camera = 0;    // index into the scene's cameras (0 with none: frame the bounds)
+  // Russian roulette from this bounce on (a value above maxDepth turns it off, e.g. to compare
+  // with renderers that trace every path to full length).
+  int rouletteStartDepth = 3;
+  int camera = 0;  // index into the scene's cameras (0 with none: frame the bounds)
 };
 
 struct RenderStats {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "denoise/buffers/buffers_exr.h"
 #include "renderer/integrator/film.h"
 
 namespace chorus::render {
@@ -123,6 +124,28 @@ TEST(Film, MergingSubBuffersEqualsAccumulatingTogether) {
         EXPECT_NEAR(v1[c], v2[c], 1e-4f * std::max(1e-6f, v2[c]));
       }
     }
+}
+
+TEST(Film, MovingBuffersIntoExrLayersGivesTheSameLayersAsCopying) {
+  std::mt19937 rng(19);
+  Film film(3, 2, 4);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 3; ++x) {
+      PixelAccumulator pixel;
+      for (int i = 0; i < 9; ++i) pixel.add(i % 4, randomSample(rng));
+      film.store(x, y, pixel);
+    }
+  SampleBuffers buffers = film.release();
+  const std::vector<ExrLayer> copied = sampleBuffersToLayers(buffers);
+  const std::vector<ExrLayer> moved = sampleBuffersToLayers(std::move(buffers));
+  ASSERT_EQ(copied.size(), moved.size());
+  for (size_t i = 0; i < copied.size(); ++i) {
+    EXPECT_EQ(copied[i].name, moved[i].name);
+    ASSERT_TRUE(copied[i].image.sameShape(moved[i].image)) << copied[i].name;
+    EXPECT_TRUE(std::equal(copied[i].image.values().begin(), copied[i].image.values().end(),
+                           moved[i].image.values().begin()))
+        << copied[i].name;
+  }
 }
 
 }  // namespace

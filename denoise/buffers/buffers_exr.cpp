@@ -19,6 +19,16 @@ void appendSubBuffer(std::vector<ExrLayer>& layers, const SubBuffer& sub,
   layers.push_back({prefix + "sampleCount", sub.sampleCount});
 }
 
+void appendSubBuffer(std::vector<ExrLayer>& layers, SubBuffer&& sub, const std::string& prefix) {
+  for (Quantity q : kAllQuantities) {
+    const std::string name = std::string(quantityName(q));
+    const bool defaultLayer = prefix.empty() && q == Quantity::Color;
+    layers.push_back({defaultLayer ? "" : prefix + name, std::move(sub.get(q).mean)});
+    layers.push_back({prefix + name + "Variance", std::move(sub.get(q).varianceOfMean)});
+  }
+  layers.push_back({prefix + "sampleCount", std::move(sub.sampleCount)});
+}
+
 const Image& requireLayer(const std::vector<ExrLayer>& layers, const std::string& name,
                           int channels, const std::filesystem::path& file) {
   const ExrLayer* layer = findLayer(layers, name);
@@ -54,6 +64,16 @@ std::vector<ExrLayer> sampleBuffersToLayers(const SampleBuffers& buffers) {
   if (buffers.splitCount() > 1)
     for (int k = 0; k < buffers.splitCount(); ++k)
       appendSubBuffer(layers, buffers.sub(k), "sub" + std::to_string(k) + ".");
+  return layers;
+}
+
+std::vector<ExrLayer> sampleBuffersToLayers(SampleBuffers&& buffers) {
+  std::vector<ExrLayer> layers;
+  appendSubBuffer(layers, buffers.part(BufferPart::Full), "");
+  if (buffers.splitCount() > 1)
+    for (int k = 0; k < buffers.splitCount(); ++k)
+      appendSubBuffer(layers, std::move(buffers.sub(k)), "sub" + std::to_string(k) + ".");
+  buffers = SampleBuffers();
   return layers;
 }
 

@@ -19,6 +19,9 @@
 namespace chorus {
 
 std::vector<ExrLayer> sampleBuffersToLayers(const SampleBuffers& buffers);
+// The same, moving the sub-buffers' images into the layers instead of copying them (halves the
+// peak memory of writing a large render; `buffers` is left empty).
+std::vector<ExrLayer> sampleBuffersToLayers(SampleBuffers&& buffers);
 SampleBuffers sampleBuffersFromLayers(const std::vector<ExrLayer>& layers,
                                       const std::filesystem::path& fileForErrors);
 

@@ -132,22 +132,17 @@ std::optional<LightSample> LightSet::sampleArea(const AreaLight& light, Vec3f re
   const float distanceSquared = lengthSquared(toLight);
   if (!(distanceSquared > 0)) return std::nullopt;
   const Vec3f wi = toLight / std::sqrt(distanceSquared);
-  // The same evaluation as a ray hitting the light (emission side, texture, normal).
-  Hit hit;
-  hit.geomID = light.geomID;
-  hit.primID = light.primID;
-  hit.u = b.y;
-  hit.v = 1 - b.x - b.y;
-  const SurfaceInteraction si = scene_->interaction(hit, wi);
-  const float cosLight = std::abs(dot(si.geometricNormal, wi));
+  const Scene::EmitterPoint e =
+      scene_->emitterPoint(light.geomID, light.primID, b.y, 1 - b.x - b.y, wi);
+  const float cosLight = std::abs(dot(e.geometricNormal, wi));
   if (!(cosLight > 0)) return std::nullopt;
   LightSample s;
-  s.Li = scene_->emitted(si);
+  s.Li = e.Le;
   s.wi = wi;
   s.pdf = distanceSquared / (cosLight * light.area);
-  s.pLight = si.position;
-  s.pLightError = si.positionError;
-  s.nLight = si.geometricNormal;
+  s.pLight = e.position;
+  s.pLightError = e.positionError;
+  s.nLight = e.geometricNormal;
   return s;
 }
 

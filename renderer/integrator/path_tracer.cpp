@@ -111,7 +111,11 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& r
     // transmissive ones keep their outward frame so that wo.z < 0 means "from inside".
     Vec3f ng = si.geometricNormal, ns = si.shadingNormal;
     if (!transmissive && dot(wo, ng) < 0) ng = -ng, ns = -ns;
-    Frame frame = Frame::fromZX(ns, si.tangent);
+    // si.tangent is already orthonormal to the shading normal.
+    Frame frame;
+    frame.x = si.tangent;
+    frame.y = cross(ns, si.tangent);
+    frame.z = ns;
     Vec3f woLocal = frame.toLocal(wo);
     if (!transmissive && woLocal.z < 1e-4f) {
       // A shading normal that faces away from the viewer: shade with the geometric one.
@@ -130,12 +134,12 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& r
         const Vec3f wiLocal = frame.toLocal(ls->wi);
         const bool sameSide = (dot(ls->wi, ng) > 0) == (dot(wo, ng) > 0);
         if (transmissive || sameSide) {
-          const Rgb f = bsdf.f(woLocal, wiLocal) * std::abs(wiLocal.z);
+          const BsdfEval eval = bsdf.evaluate(woLocal, wiLocal);
+          const Rgb f = eval.f * std::abs(wiLocal.z);
           if (!f.isBlack()) {
             ++rays;
             if (unoccluded(si, ng, *ls)) {
-              const float w =
-                  ls->isDelta ? 1.0f : powerHeuristic(ls->pdf, bsdf.pdf(woLocal, wiLocal));
+              const float w = ls->isDelta ? 1.0f : powerHeuristic(ls->pdf, eval.pdf);
               L += beta * f * ls->Li * (w / ls->pdf);
               lightVisible = true;
             }

@@ -9,7 +9,9 @@
 // the outgoing direction, so the new ray cannot re-hit the surface it left and cannot start on
 // the far side of it (no leaks).
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "renderer/math/vec.h"
@@ -28,6 +30,17 @@ inline Vec3f barycentricPositionError(Vec3f p0, Vec3f p1, Vec3f p2, float b0, fl
   return (abs(p0 * b0) + abs(p1 * b1) + abs(p2 * b2)) * (roundingGamma(7) * kOffsetSafety);
 }
 
+// The next representable float above / below v (finite v; ±0 step to the smallest subnormal).
+inline float nextFloatUp(float v) {
+  if (v == 0.0f) return std::numeric_limits<float>::denorm_min();
+  uint32_t bits = std::bit_cast<uint32_t>(v);
+  bits = v > 0 ? bits + 1 : bits - 1;
+  return std::bit_cast<float>(bits);
+}
+inline float nextFloatDown(float v) {
+  return -nextFloatUp(-v);
+}
+
 // Smallest offset, for points whose rounding bound is 0 (all vertices at coordinate 0).
 inline constexpr float kMinOffset = 1e-9f;
 
@@ -44,9 +57,9 @@ inline Vec3f offsetRayOrigin(Vec3f p, Vec3f pError, Vec3f n, Vec3f w) {
   // Round away from p so that the offset survives the addition's rounding.
   for (int i = 0; i < 3; ++i) {
     if (offset[i] > 0)
-      po[i] = std::nextafter(po[i], std::numeric_limits<float>::infinity());
+      po[i] = nextFloatUp(po[i]);
     else if (offset[i] < 0)
-      po[i] = std::nextafter(po[i], -std::numeric_limits<float>::infinity());
+      po[i] = nextFloatDown(po[i]);
   }
   return po;
 }

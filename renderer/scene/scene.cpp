@@ -98,6 +98,26 @@ bool materialNeedsAlphaTest(const MaterialDesc& m, const std::vector<TextureDesc
   return !(textureOpaque && m.alpha >= threshold);
 }
 
+// The unit geometric normal of a triangle, turned to the side its vertex normals face (the
+// authored normals define the outside; the winding may disagree).
+Vec3f orientedGeometricNormal(const MeshDesc& mesh, const uint32_t* idx, Vec3f p0, Vec3f p1,
+                              Vec3f p2, float b0, float b1, float b2, Vec3f* interpolatedNormal) {
+  Vec3f ng = cross(p1 - p0, p2 - p0);
+  const float ngLength = length(ng);
+  ng = ngLength > 0 ? ng / ngLength : Vec3f{0, 0, 1};
+  *interpolatedNormal = ng;
+  if (!mesh.normals.empty()) {
+    const Vec3f n =
+        mesh.normals[idx[0]] * b0 + mesh.normals[idx[1]] * b1 + mesh.normals[idx[2]] * b2;
+    const float len = length(n);
+    if (len > 1e-6f && std::isfinite(len)) {
+      *interpolatedNormal = n / len;
+      if (dot(*interpolatedNormal, ng) < 0) ng = -ng;
+    }
+  }
+  return ng;
+}
+
 }  // namespace
 
 Scene::Scene() : data_(std::make_unique<SceneData>()), embree_(std::make_unique<Embree>()) {}
@@ -242,23 +262,10 @@ SurfaceInteraction Scene::interaction(const Hit& hit, Vec3f rayDirection) const 
   si.material = mesh.material;
   si.position = p0 * b0 + p1 * b1 + p2 * b2;
   si.positionError = barycentricPositionError(p0, p1, p2, b0, b1, b2);
-  Vec3f ng = cross(p1 - p0, p2 - p0);
-  const float ngLength = length(ng);
-  ng = ngLength > 0 ? ng / ngLength : Vec3f{0, 0, 1};
   si.uv = mesh.uvs.empty() ? Vec2f{0, 0}
                            : mesh.uvs[idx[0]] * b0 + mesh.uvs[idx[1]] * b1 + mesh.uvs[idx[2]] * b2;
-
-  Vec3f ns = ng;
-  if (!mesh.normals.empty()) {
-    const Vec3f n =
-        mesh.normals[idx[0]] * b0 + mesh.normals[idx[1]] * b1 + mesh.normals[idx[2]] * b2;
-    const float len = length(n);
-    if (len > 1e-6f && std::isfinite(len)) {
-      ns = n / len;
-      // The authored normals define the outside; the winding may disagree.
-      if (dot(ns, ng) < 0) ng = -ng;
-    }
-  }
+  Vec3f ns;
+  const Vec3f ng = orientedGeometricNormal(mesh, idx, p0, p1, p2, b0, b1, b2, &ns);
 
   const MaterialDesc& material = data_->materials[size_t(mesh.material)].desc;
   Vec3f tangent;
@@ -277,7 +284,7 @@ SurfaceInteraction Scene::interaction(const Hit& hit, Vec3f rayDirection) const 
       bitangentSign = dot(cross(ns, tangent), bitangent) < 0 ? -1.0f : 1.0f;
     }
   }
-  Frame frame = Frame::fromZX(ns, tangent);
+  Frame frame = lengthSquared(tangent) > 0 ? Frame::fromZX(ns, tangent) : Frame::fromZ(ns);
   if (material.normalTexture >= 0 && !mesh.uvs.empty()) {
     Frame tangentFrame = frame;
     tangentFrame.y = frame.y * bitangentSign;
@@ -294,6 +301,28 @@ SurfaceInteraction Scene::interaction(const Hit& hit, Vec3f rayDirection) const 
 
 MaterialPoint Scene::materialPoint(const SurfaceInteraction& si) const {
   return evaluateMaterial(data_->materials[size_t(si.material)].desc, data_->textures, si.uv);
+}
+
+Scene::EmitterPoint Scene::emitterPoint(uint32_t geomID, uint32_t primID, float b1, float b2,
+                                        Vec3f direction) const {
+  const MeshDesc& mesh = data_->meshes[geomID].mesh;
+  const uint32_t* idx = &mesh.indices[3 * size_t(primID)];
+  const float b0 = 1 - b1 - b2;
+  const Vec3f p0 = mesh.positions[idx[0]], p1 = mesh.positions[idx[1]], p2 = mesh.positions[idx[2]];
+  EmitterPoint e;
+  e.position = p0 * b0 + p1 * b1 + p2 * b2;
+  e.positionError = barycentricPositionError(p0, p1, p2, b0, b1, b2);
+  Vec3f ns;
+  e.geometricNormal = orientedGeometricNormal(mesh, idx, p0, p1, p2, b0, b1, b2, &ns);
+  const MaterialDesc& m = data_->materials[size_t(mesh.material)].desc;
+  const bool front = dot(direction, e.geometricNormal) < 0;
+  if (m.isEmissive() && (front || m.doubleSided)) {
+    const Vec2f uv = mesh.uvs.empty() || m.emissiveTexture < 0
+                         ? Vec2f{0, 0}
+                         : mesh.uvs[idx[0]] * b0 + mesh.uvs[idx[1]] * b1 + mesh.uvs[idx[2]] * b2;
+    e.Le = evaluateEmission(m, data_->textures, uv);
+  }
+  return e;
 }
 
 Rgb Scene::emitted(const SurfaceInteraction& si) const {

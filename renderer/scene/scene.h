@@ -34,7 +34,7 @@ struct SurfaceInteraction {
   Vec3f positionError;    // conservative bound on |position − exact point|, per axis
   Vec3f geometricNormal;  // unit; oriented to the side the interpolated vertex normals face
   Vec3f shadingNormal;    // unit; interpolated and normal-mapped, same side as geometricNormal
-  Vec3f tangent;          // unit, ⟂ shadingNormal (for the local shading frame)
+  Vec3f tangent;          // unit, ⟂ shadingNormal: frame = (tangent, n × tangent, n)
   Vec2f uv;
   bool frontFace = true;  // the ray arrived from the side geometricNormal points to
   int material = 0;
@@ -83,6 +83,16 @@ class Scene {
   MaterialPoint materialPoint(const SurfaceInteraction& si) const;
   // Radiance emitted toward −rayDirection (zero behind single-sided emitters).
   Rgb emitted(const SurfaceInteraction& si) const;
+
+  // A point on an emissive triangle (barycentrics b1, b2 of vertices 1 and 2) seen along
+  // `direction` (from the receiver toward the point): the light-sampling counterpart of
+  // interaction() + emitted(), without the shading frame.
+  struct EmitterPoint {
+    Vec3f position, positionError, geometricNormal;
+    Rgb Le;
+  };
+  EmitterPoint emitterPoint(uint32_t geomID, uint32_t primID, float b1, float b2,
+                            Vec3f direction) const;
 
   const SceneData& data() const { return *data_; }
   const Material& material(int index) const { return data_->materials[size_t(index)]; }

@@ -111,17 +111,19 @@ void runRender(RenderArgs args) {
               << " has no lights: rendering under a uniform white environment (radiance 1)\n";
 
   ProgressBar bar(!args.quiet && ProgressBar::stderrIsTerminal());
-  const RenderResult result =
+  RenderResult result =
       render::render(scene, args.options, [&bar](const RenderProgress& p) { bar.update(p); });
   bar.finish();
 
   const fs::path out = args.out;
   ensureDirectory(out);
-  writeExr(out / "render.exr", sampleBuffersToLayers(result.buffers), ExrPixelType::Float);
-  writePng(out / "color.png", result.buffers.part(BufferPart::Full).color.mean);
   nlohmann::ordered_json stats =
       statsJson(args, result.stats, loadSeconds, buildSeconds, scene, warnings);
   denoise.run(result.buffers, out, stats);
+  // The buffers move into the EXR layers (no second copy of a large render in memory).
+  const std::vector<ExrLayer> layers = sampleBuffersToLayers(std::move(result.buffers));
+  writeExr(out / "render.exr", layers, ExrPixelType::Float);
+  writePng(out / "color.png", layers.front().image);  // the full-buffer colour mean
   writeTextAtomically(out / "stats.json", stats.dump(2) + "\n");
 
   if (!args.quiet) {

@@ -1,0 +1,223 @@
+// Renderer throughput and memory (not a test; prints figures):
+//   1. chorus on a scene (default scenes/cornell-box.gltf, 512×512, 64 spp, 2 threads): samples/s
+//      and rays/s, with Russian roulette (the default) and without (every path to max depth 8,
+//      comparable with the peer);
+//   2. the peer: Embree's own tutorial path tracer (Debian package embree-tools) on its Cornell
+//      box at the same size, spp and thread count, when /usr/bin/pathtracer exists;
+//   3. raw Embree: rtcIntersect1 / rtcOccluded1 (through Scene::intersect / occluded, thin
+//      wrappers) on random rays inside the same scene, no shading;
+//   4. peak resident memory after rendering 1920×1080 with K = 4 (and after building the
+//      render.exr layers the CLI writes).
+// Wall-clock rates suffer when other processes share the machine, so CPU-time rates (samples per
+// CPU-second, from getrusage) are printed next to them; the ratio between renderers is best read
+// from those.
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include <unistd.h>
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "denoise/buffers/buffers_exr.h"
+#include "renderer/render.h"
+#include "renderer/sampling/warps.h"
+#include "renderer/scene/gltf_loader.h"
+
+namespace {
+
+using namespace chorus;
+using namespace chorus::render;
+using Clock = std::chrono::steady_clock;
+
+double cpuSeconds(int who) {
+  rusage u{};
+  getrusage(who, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+double peakMemoryMB() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+struct Timing {
+  double wall = 0, cpu = 0;
+};
+
+template <typename F>
+Timing timed(F&& f) {
+  const auto start = Clock::now();
+  const double cpu0 = cpuSeconds(RUSAGE_SELF);
+  f();
+  return {std::chrono::duration<double>(Clock::now() - start).count(),
+          cpuSeconds(RUSAGE_SELF) - cpu0};
+}
+
+void reportRender(const char* label, const RenderStats& s, const Timing& t) {
+  std::printf(
+      "%-34s %7.2f s  %6.3f M samples/s  %6.2f M rays/s  %5.2f rays/sample  | per CPU-s: %6.3f M "
+      "samples  %6.2f M rays\n",
+      label, s.renderSeconds, s.samplesPerSecond() / 1e6, s.raysPerSecond() / 1e6,
+      double(s.rays) / double(s.samples), double(s.samples) / t.cpu / 1e6,
+      double(s.rays) / t.cpu / 1e6);
+}
+
+// Random rays from inside the scene bounds (shrunk to 90%) in uniform directions.
+void rawEmbree(const Scene& scene, int threads, size_t rayCount) {
+  const Bounds3f b = scene.bounds();
+  std::vector<Ray> rays(rayCount);
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (Ray& r : rays) {
+    const Vec3f t{0.05f + 0.9f * u(rng), 0.05f + 0.9f * u(rng), 0.05f + 0.9f * u(rng)};
+    r.origin = b.min + Vec3f{b.diagonal().x * t.x, b.diagonal().y * t.y, b.diagonal().z * t.z};
+    r.direction = sampleUniformSphere({u(rng), u(rng)});
+  }
+  tbb::task_arena arena(threads);
+  std::atomic<size_t> hits{0};
+  const auto run = [&](bool occlusion) {
+    return timed([&] {
+      arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096),
+                          [&](const tbb::blocked_range<size_t>& range) {
+                            size_t local = 0;
+                            for (size_t i = range.begin(); i < range.end(); ++i) {
+                              if (occlusion) {
+                                local +=
+                                    scene.occluded(rays[i].origin, rays[i].direction, rays[i].tMax);
+                              } else {
+                                Hit hit;
+                                local += scene.intersect(rays[i], &hit);
+                              }
+                            }
+                            hits += local;
+                          });
+      });
+    });
+  };
+  run(false);  // warm up
+  hits = 0;
+  const Timing closest = run(false);
+  const size_t closestHits = hits.exchange(0);
+  const Timing occluded = run(true);
+  std::printf(
+      "%-34s %6.2f M closest-hit rays/s (%.0f%% hit)  %6.2f M occlusion rays/s  | per CPU-s: %6.2f "
+      "M / %6.2f M\n",
+      "raw Embree (random rays)", double(rayCount) / closest.wall / 1e6,
+      100.0 * double(closestHits) / double(rayCount), double(rayCount) / occluded.wall / 1e6,
+      double(rayCount) / closest.cpu / 1e6, double(rayCount) / occluded.cpu / 1e6);
+}
+
+// Runs Embree's tutorial path tracer headless; returns false when it is not installed.
+bool peer(int size, int spp, int threads) {
+  const char* binary = "/usr/bin/pathtracer";
+  const char* config = "/usr/share/doc/embree3/models/cornell_box.ecs";
+  if (!std::filesystem::exists(binary) || !std::filesystem::exists(config)) return false;
+  const std::string out =
+      (std::filesystem::temp_directory_path() / "bench_render_peer.ppm").string();
+  const std::string sizeText = std::to_string(size), sppText = std::to_string(spp),
+                    threadText = std::to_string(threads);
+  std::fflush(stdout);  // the child must not inherit (and repeat) buffered output
+  const auto start = Clock::now();
+  const pid_t pid = fork();
+  if (pid == 0) {
+    if (!std::freopen("/dev/null", "w", stdout)) _exit(127);
+    execl(binary, binary, "-c", config, "--size", sizeText.c_str(), sizeText.c_str(), "--spp",
+          sppText.c_str(), "--threads", threadText.c_str(), "-o", out.c_str(), (char*)nullptr);
+    _exit(127);
+  }
+  int status = 0;
+  rusage usage{};
+  wait4(pid, &status, 0, &usage);
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  const double cpu = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                     1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+  std::filesystem::remove(out);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    std::printf("peer pathtracer failed (status %d)\n", status);
+    return true;
+  }
+  const double samples = double(size) * size * spp;
+  std::printf(
+      "%-34s %7.2f s  %6.3f M samples/s  (rays not reported; process time incl. load)  | per "
+      "CPU-s: %6.3f M samples\n",
+      "Embree tutorial pathtracer (peer)", wall, samples / wall / 1e6, samples / cpu / 1e6);
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "bench_render: chorus renderer throughput against Embree's tutorial path tracer and raw "
+      "Embree, and peak memory"};
+  std::string scenePath = "scenes/cornell-box.gltf";
+  int size = 512, spp = 64, threads = 2;
+  bool skipPeer = false, skipMemory = false;
+  app.add_option("--scene", scenePath, "glTF scene")->capture_default_str();
+  app.add_option("--size", size, "Image width and height")->capture_default_str();
+  app.add_option("--spp", spp, "Samples per pixel")->capture_default_str();
+  app.add_option("--threads", threads, "Threads")->capture_default_str();
+  app.add_flag("--skip-peer", skipPeer, "Do not run Embree's pathtracer");
+  app.add_flag("--skip-memory", skipMemory, "Do not render 1920x1080 for the memory figure");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    std::printf("scene %s, %dx%d, %d spp, %d threads, %u hardware threads\n", scenePath.c_str(),
+                size, size, spp, threads, std::thread::hardware_concurrency());
+    const auto loadStart = Clock::now();
+    const Scene scene = buildScene(loadGltf(scenePath), EnvironmentDesc{});
+    std::printf("load + BVH build %.3f s, %zu triangles\n",
+                std::chrono::duration<double>(Clock::now() - loadStart).count(),
+                scene.data().triangleCount);
+
+    RenderOptions options;
+    options.width = options.height = size;
+    options.spp = spp;
+    options.threads = threads;
+    options.splits = 4;
+    RenderResult result;
+    Timing t = timed([&] { result = render::render(scene, options); });
+    reportRender("chorus (Russian roulette, depth 8)", result.stats, t);
+    options.rouletteStartDepth = options.maxDepth + 1;
+    t = timed([&] { result = render::render(scene, options); });
+    reportRender("chorus (no roulette, depth 8)", result.stats, t);
+
+    if (skipPeer || !peer(size, spp, threads)) std::printf("peer: /usr/bin/pathtracer not run\n");
+    rawEmbree(scene, threads, 4'000'000);
+
+    if (!skipMemory) {
+      result = RenderResult{};
+      RenderOptions big;
+      big.width = 1920;
+      big.height = 1080;
+      big.spp = 4;
+      big.splits = 4;
+      big.threads = threads;
+      {
+        RenderResult r = render::render(scene, big);
+        std::printf("peak RSS after 1920x1080 K=4 render:                      %7.1f MB\n",
+                    peakMemoryMB());
+        const std::vector<ExrLayer> layers = sampleBuffersToLayers(std::move(r.buffers));
+        std::printf(
+            "peak RSS with the render.exr layers (moved, as the CLI):  %7.1f MB (%zu layers)\n",
+            peakMemoryMB(), layers.size());
+      }
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_render: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -6,6 +6,7 @@
 #include "denoise/base/bilateral.h"
 #include "denoise/base/dual_buffer_nlm.h"
 #include "denoise/base/nfor.h"
+#include "denoise/base/rdfc.h"
 #include "denoise/base/sbf.h"
 
 #include "denoise/util/error.h"
@@ -33,6 +34,10 @@ const std::vector<DenoiserEntry>& builtinDenoisers() {
       {"bilateral",
        "joint cross-bilateral filter on normal, albedo, depth and colour (SBF's building block)",
        [](ParamMap& p) { return std::make_unique<Bilateral>(BilateralParams::fromParams(p)); }},
+      {"rdfc",
+       "SURE-selected NL-means candidates with feature prefiltering and a second pass "
+       "(Rousselle et al. 2013)",
+       [](ParamMap& p) { return std::make_unique<Rdfc>(RdfcParams::fromParams(p)); }},
   };
   return entries;
 }

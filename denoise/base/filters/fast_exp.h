@@ -50,4 +50,23 @@ inline void expNonPositiveInPlace(float* __restrict values, size_t n) {
   for (size_t i = 0; i < n; ++i) values[i] = expNonPositiveUnclamped(values[i]);
 }
 
+// exp(x) for x already in [−87, 0] (the caller clamps; no check here): expNonPositive's
+// polynomial without its branches, so that loops calling it vectorise (with floating-point traps
+// off in the calling file, e.g. `#pragma GCC optimize("no-trapping-math")`).
+inline float expClamped(float x) {
+  constexpr float kLog2e = 1.44269504088896341f;
+  constexpr float kLn2Hi = 0.693359375f;
+  constexpr float kLn2Lo = -2.12194440e-4f;
+  const float n = float(int32_t(x * kLog2e - 0.5f));
+  const float r = (x - n * kLn2Hi) - n * kLn2Lo;
+  float p = 1.9875691500e-4f;
+  p = p * r + 1.3981999507e-3f;
+  p = p * r + 8.3334519073e-3f;
+  p = p * r + 4.1665795894e-2f;
+  p = p * r + 1.6666665459e-1f;
+  p = p * r + 5.0000001201e-1f;
+  p = p * r * r + r + 1.0f;
+  return p * std::bit_cast<float>(uint32_t(int32_t(n) + 127) << 23);
+}
+
 }  // namespace chorus

@@ -149,6 +149,16 @@ void NlMeansWeights::patchDistance(int term, const PixelRect& region, int dx, in
   termPatchDistance(terms_.at(size_t(term)), region, dx, dy, false, scratch, out);
 }
 
+void NlMeansWeights::symmetricPatchDistance(int term, const PixelRect& region, int dx, int dy,
+                                            NlMeansScratch& scratch, float* out) const {
+  const PixelRect valid = neighbourInside(width_, height_, dx, dy)
+                              .intersect(neighbourInside(width_, height_, -dx, -dy));
+  if (region.intersect(valid) != region)
+    throw std::invalid_argument(
+        "symmetricPatchDistance: region has pixels whose neighbours are outside");
+  termPatchDistance(terms_.at(size_t(term)), region, dx, dy, true, scratch, out);
+}
+
 void NlMeansWeights::termWeights(const PreparedTerm& t, const float* distance, size_t area,
                                  float* out) const {
   // First −min(max(0, D), kMaxExpArgument) (weights are exp of it), then the exponential, in

@@ -125,6 +125,13 @@ class NlMeansWeights {
   void patchDistance(int term, const PixelRect& region, int dx, int dy, NlMeansScratch& scratch,
                      float* out) const;
 
+  // Like patchDistance, but the distance of the symmetric-pair refinement: from p to the mean
+  // of p + δ and p − δ (variance terms (V(p+δ) + V(p−δ)) / 4). `region` must lie inside both
+  // neighbourInside(width, height, ±dx, ±dy); the patch mean counts the pixels whose two
+  // neighbours exist. (RDFC's SURE derivative perturbs these distances.)
+  void symmetricPatchDistance(int term, const PixelRect& region, int dx, int dy,
+                              NlMeansScratch& scratch, float* out) const;
+
   // How many planes patchDistance writes for a term.
   int distanceChannels(int term) const;
 

@@ -1,0 +1,514 @@
+#include "denoise/base/rdfc_candidates.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "denoise/base/filters/pixel_rect.h"
+#include "denoise/base/rdfc_row_kernels.h"
+#include "denoise/base/sure.h"
+
+namespace chorus {
+namespace {
+
+constexpr int kTileWidth = 64, kTileHeight = 32;
+constexpr float kMinCenterWeight = 1e-3f;  // the release's WEIGHT_EPSILON
+constexpr float kSymmetricLimit = 25.0f;   // refine only where both distances are below this
+constexpr int kColor = 2;                  // FIRST and SECOND have a colour term
+enum Kind { kPlus, kMinus, kSym };
+
+// Planar copy with a zero border, so the row kernels may read any neighbour within `pad`.
+class PaddedPlanes {
+ public:
+  PaddedPlanes() = default;
+  PaddedPlanes(int width, int height, int channels, int pad)
+      : pad_(pad),
+        stride_(size_t(width + 2 * pad)),
+        planeSize_(stride_ * size_t(height + 2 * pad)),
+        data_(planeSize_ * size_t(channels), 0.0f) {}
+  // Channel c of this ← channel sourceChannel of image × scale.
+  void set(int c, const Image& image, int sourceChannel, float scale) {
+    for (int y = 0; y < image.height(); ++y)
+      for (int x = 0; x < image.width(); ++x)
+        mutableRow(c, y)[x] = scale * image(x, y, sourceChannel);
+  }
+  float* mutableRow(int c, int y) {
+    return data_.data() + size_t(c) * planeSize_ + size_t(y + pad_) * stride_ + size_t(pad_);
+  }
+  const float* row(int c, int y) const {
+    return data_.data() + size_t(c) * planeSize_ + size_t(y + pad_) * stride_ + size_t(pad_);
+  }
+
+ private:
+  int pad_ = 0;
+  size_t stride_ = 0, planeSize_ = 0;
+  std::vector<float> data_;
+};
+
+// Patch offsets o ∈ [−f, f] along one axis with x + o in [lo, hi).
+int overlap(int x, int f, int lo, int hi) {
+  return std::max(0, std::min(x + f + 1, hi) - std::max(x - f, lo));
+}
+
+struct TileMemory {
+  std::vector<float> mask[5];  // plus, minus, sym, behind (p−δ, p−2δ), ahead (p+δ, p+2δ)
+  std::vector<float> featPlus[2], featMinus[2];  // feature weights, τ sets FIRST/SECOND, THIRD
+  std::vector<float> termRow[6];                 // one term's distances: A ±/s, B ±/s
+  std::vector<float> ext[3];                     // colour pixel distances over the grown tile
+  std::vector<float> rowSums, invCountX;         // box filter: horizontal sums, 1 / x counts
+  std::vector<float> dist[kColor][3], invCount[kColor][3];
+  std::vector<float> slope[3][3], nearSlope[3][3], combined[3];  // [channel][kind]
+  std::vector<float> wPlus, wMinus;
+  std::vector<float> termStore[13];  // rows of rdfc::ColorWeightTerms
+  rdfc::ColorWeightTerms terms;
+  // Accumulators, per candidate: Σw, max w, Σ w b1 (3 planes), Σ w b2 (3 planes); per colour
+  // candidate and channel of y(p): Σ ∂w, Σ ∂w y(q), ∂(max w).
+  std::vector<float> weightSum[3], maxWeight[3], acc[3];
+  std::vector<float> derivativeSum[kColor], derivativeAcc[kColor], maxDerivative[kColor];
+};
+
+class CandidateKernel {
+ public:
+  CandidateKernel(const Image& b1, const Image& b2, const Image& variance,
+                  const std::vector<RdfcFeature>& features, const RdfcCandidateParams& params);
+  std::array<RdfcCandidate, 3> run() const;
+
+ private:
+  struct Outputs {
+    std::array<Image, 3> buffer1, buffer2, derivative;
+  };
+  void runTile(const PixelRect& tile, TileMemory& m, Outputs& out) const;
+  void masks(const PixelRect& tile, int dx, int dy, TileMemory& m) const;
+  void featureWeights(const PixelRect& tile, int dx, int dy, TileMemory& m) const;
+  void colorDistances(const PixelRect& tile, int dx, int dy, TileMemory& m) const;
+  void accumulate(const PixelRect& tile, int dx, int dy, TileMemory& m) const;
+  void finishTile(const PixelRect& tile, const TileMemory& m, Outputs& out) const;
+
+  int width_, height_, pad_, grow_;
+  RdfcCandidateParams params_;
+  int patch_[kColor];
+  float refineMinWeight_;
+  Image guide_, variance_;
+  PaddedPlanes b1_, b2_, g_, vn_, vd_;
+  // Features: one plane per channel of every feature, its term's channel range.
+  PaddedPlanes fValue_, fNum_, fDen_[2];
+  std::vector<int> termBegin_;
+};
+
+CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& variance,
+                                 const std::vector<RdfcFeature>& features,
+                                 const RdfcCandidateParams& params)
+    : width_(b1.width()),
+      height_(b1.height()),
+      params_(params),
+      patch_{params.fFirst, params.fSecond},
+      refineMinWeight_(std::exp(-kSymmetricLimit)),
+      variance_(variance) {
+  if (!b1.sameShape(b2) || !b1.sameShape(variance) || b1.channels() != 3)
+    throw std::invalid_argument("rdfcCandidates: buffers and variance must be RGB of one size");
+  if (params.r < 1 || params.fFirst < 0 || params.fSecond < 0)
+    throw std::invalid_argument("rdfcCandidates: bad radius");
+  grow_ = std::max(params.fFirst, params.fSecond);
+  pad_ = 2 * params.r + grow_ + 1;
+  guide_ = Image(width_, height_, 3);
+  for (size_t k = 0; k < guide_.size(); ++k)
+    guide_.data()[k] = 0.5f * (b1.data()[k] + b2.data()[k]);
+  for (PaddedPlanes* p : {&b1_, &b2_, &g_, &vn_, &vd_}) *p = PaddedPlanes(width_, height_, 3, pad_);
+  for (int c = 0; c < 3; ++c) {
+    b1_.set(c, b1, c, 1.0f);
+    b2_.set(c, b2, c, 1.0f);
+    g_.set(c, guide_, c, 1.0f);
+    vn_.set(c, variance, c, 1.0f);  // α = 1
+    vd_.set(c, variance, c, params.kc * params.kc);
+  }
+
+  int channels = 0;
+  for (const RdfcFeature& f : features) {
+    termBegin_.push_back(channels);
+    channels += f.value.channels();
+  }
+  termBegin_.push_back(channels);
+  fValue_ = PaddedPlanes(width_, height_, channels, pad_);
+  fNum_ = PaddedPlanes(width_, height_, channels, pad_);
+  const float tau[2] = {params.tauFirstSecond, params.tauThird};
+  for (int set = 0; set < 2; ++set) fDen_[set] = PaddedPlanes(width_, height_, channels, pad_);
+  const float kf2 = params.kf * params.kf;
+  for (size_t j = 0; j < features.size(); ++j) {
+    const RdfcFeature& f = features[j];
+    for (int c = 0; c < f.value.channels(); ++c) {
+      const int k = termBegin_[j] + c;
+      fValue_.set(k, f.value, c, 1.0f);
+      fNum_.set(k, f.variance, c, 1.0f);  // α = 1
+      for (int set = 0; set < 2; ++set) fDen_[set].set(k, f.normalizingVariance(tau[set]), c, kf2);
+    }
+  }
+}
+
+void CandidateKernel::masks(const PixelRect& tile, int dx, int dy, TileMemory& m) const {
+  auto inside = [&](int x, int y) { return x >= 0 && y >= 0 && x < width_ && y < height_; };
+  const int tw = tile.width();
+  for (int y = tile.y0; y < tile.y1; ++y)
+    for (int x = tile.x0; x < tile.x1; ++x) {
+      const size_t i = size_t(y - tile.y0) * size_t(tw) + size_t(x - tile.x0);
+      const bool plus = inside(x + dx, y + dy), minus = inside(x - dx, y - dy);
+      m.mask[kPlus][i] = plus ? 1.0f : 0.0f;
+      m.mask[kMinus][i] = minus ? 1.0f : 0.0f;
+      m.mask[kSym][i] = plus && minus ? 1.0f : 0.0f;
+      m.mask[3][i] = minus && inside(x - 2 * dx, y - 2 * dy) ? 1.0f : 0.0f;
+      m.mask[4][i] = plus && inside(x + 2 * dx, y + 2 * dy) ? 1.0f : 0.0f;
+    }
+}
+
+void CandidateKernel::featureWeights(const PixelRect& tile, int dx, int dy, TileMemory& m) const {
+  const int tw = tile.width();
+  const size_t area = size_t(tile.area());
+  for (int set = 0; set < 2; ++set) {
+    std::fill(m.featPlus[set].begin(), m.featPlus[set].begin() + ptrdiff_t(area), 1.0f);
+    std::fill(m.featMinus[set].begin(), m.featMinus[set].begin() + ptrdiff_t(area), 1.0f);
+  }
+  for (int y = tile.y0; y < tile.y1; ++y) {
+    const size_t row = size_t(y - tile.y0) * size_t(tw);
+    const int x0 = tile.x0;
+    for (size_t term = 0; term + 1 < termBegin_.size(); ++term) {
+      for (auto& r : m.termRow) std::fill(r.begin(), r.begin() + tw, 0.0f);
+      for (int k = termBegin_[term]; k < termBegin_[term + 1]; ++k) {
+        const float* f = fValue_.row(k, y) + x0;
+        const float* fp = fValue_.row(k, y + dy) + x0 + dx;
+        const float* fm = fValue_.row(k, y - dy) + x0 - dx;
+        const float* n = fNum_.row(k, y) + x0;
+        const float* np = fNum_.row(k, y + dy) + x0 + dx;
+        const float* nm = fNum_.row(k, y - dy) + x0 - dx;
+        const float* a = fDen_[0].row(k, y) + x0;
+        const float* ap = fDen_[0].row(k, y + dy) + x0 + dx;
+        const float* am = fDen_[0].row(k, y - dy) + x0 - dx;
+        const float* b = fDen_[1].row(k, y) + x0;
+        const float* bp = fDen_[1].row(k, y + dy) + x0 + dx;
+        const float* bm = fDen_[1].row(k, y - dy) + x0 - dx;
+        rdfc::addPairDistance(tw, f, fp, n, np, a, ap, b, bp, m.termRow[0].data(),
+                              m.termRow[3].data());
+        rdfc::addPairDistance(tw, f, fm, n, nm, a, am, b, bm, m.termRow[1].data(),
+                              m.termRow[4].data());
+        rdfc::addSymmetricDistance(tw, f, fp, fm, n, np, nm, a, ap, am, b, bp, bm,
+                                   m.termRow[2].data(), m.termRow[5].data());
+      }
+      const float scale = 1.0f / float(termBegin_[term + 1] - termBegin_[term]);
+      for (int set = 0; set < 2; ++set)
+        rdfc::minTermWeights(tw, scale, m.termRow[3 * set].data(), m.termRow[3 * set + 1].data(),
+                             m.termRow[3 * set + 2].data(), m.mask[kSym].data() + row,
+                             refineMinWeight_, m.featPlus[set].data() + row,
+                             m.featMinus[set].data() + row);
+    }
+  }
+  for (int set = 0; set < 2; ++set)
+    for (size_t i = 0; i < area; ++i) {
+      m.featPlus[set][i] *= m.mask[kPlus][i];
+      m.featMinus[set][i] *= m.mask[kMinus][i];
+    }
+}
+
+void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, TileMemory& m) const {
+  const int tw = tile.width(), th = tile.height(), G = grow_;
+  const int ex0 = tile.x0 - G, ey0 = tile.y0 - G, ew = tw + 2 * G, eh = th + 2 * G;
+  const size_t eArea = size_t(ew) * size_t(eh);
+  for (auto& e : m.ext) std::fill(e.begin(), e.begin() + ptrdiff_t(eArea), 0.0f);
+  for (int ey = 0; ey < eh; ++ey) {
+    const int y = ey0 + ey;
+    const bool tileRow = y >= tile.y0 && y < tile.y1;
+    for (int c = 0; c < 3; ++c) {
+      // Segments of the grown row: left margin, tile columns (with the slopes), right margin.
+      const int bounds[4] = {ex0, tile.x0, tile.x1, ex0 + ew};
+      for (int seg = 0; seg < 3; ++seg) {
+        const int xa = bounds[seg], n = bounds[seg + 1] - xa;
+        if (n <= 0) continue;
+        const size_t e = size_t(ey) * size_t(ew) + size_t(xa - ex0);
+        const bool withSlope = tileRow && seg == 1;
+        const size_t t = size_t(y - tile.y0) * size_t(tw);
+        rdfc::addColorDistances(
+            n, g_.row(c, y) + xa, g_.row(c, y + dy) + xa + dx, g_.row(c, y - dy) + xa - dx,
+            vn_.row(c, y) + xa, vn_.row(c, y + dy) + xa + dx, vn_.row(c, y - dy) + xa - dx,
+            vd_.row(c, y) + xa, vd_.row(c, y + dy) + xa + dx, vd_.row(c, y - dy) + xa - dx,
+            m.ext[kPlus].data() + e, m.ext[kMinus].data() + e, m.ext[kSym].data() + e,
+            withSlope ? m.slope[c][kPlus].data() + t : nullptr,
+            withSlope ? m.slope[c][kMinus].data() + t : nullptr,
+            withSlope ? m.slope[c][kSym].data() + t : nullptr);
+      }
+    }
+  }
+  // Pixels whose pair does not exist contribute nothing to the patch sums. Valid pixels of each
+  // kind form a rectangle [loX, hiX) × [loY, hiY).
+  const int W = width_, H = height_, adx = std::abs(dx), ady = std::abs(dy);
+  const int loX[3] = {std::max(0, -dx), std::max(0, dx), adx};
+  const int hiX[3] = {std::min(W, W - dx), std::min(W, W + dx), W - adx};
+  const int loY[3] = {std::max(0, -dy), std::max(0, dy), ady};
+  const int hiY[3] = {std::min(H, H - dy), std::min(H, H + dy), H - ady};
+  for (int kind = 0; kind < 3; ++kind)
+    for (int ey = 0; ey < eh; ++ey) {
+      float* row = m.ext[kind].data() + size_t(ey) * size_t(ew);
+      const int y = ey0 + ey;
+      if (y < loY[kind] || y >= hiY[kind]) {
+        std::fill(row, row + ew, 0.0f);
+        continue;
+      }
+      const int a = std::clamp(loX[kind] - ex0, 0, ew), b = std::clamp(hiX[kind] - ex0, 0, ew);
+      std::fill(row, row + a, 0.0f);
+      std::fill(row + std::max(a, b), row + ew, 0.0f);
+    }
+
+  // Patch means for both patch radii: box sums over the valid pixels × 1 / their count.
+  for (int s = 0; s < kColor; ++s) {
+    const int f = patch_[s];
+    for (int kind = 0; kind < 3; ++kind) {
+      const std::vector<float>& e = m.ext[kind];
+      for (int i = 0; i < tw; ++i) {
+        const int nx = overlap(tile.x0 + i, f, loX[kind], hiX[kind]);
+        m.invCountX[size_t(i)] = nx > 0 ? 1.0f / float(nx) : 0.0f;
+      }
+      // Horizontal sums for the rows [tile.y0 − f, tile.y1 + f), tile columns.
+      for (int y = tile.y0 - f; y < tile.y1 + f; ++y) {
+        const float* src = e.data() + size_t(y - ey0) * size_t(ew) + size_t(tile.x0 - ex0);
+        float* dst = m.rowSums.data() + size_t(y - tile.y0 + f) * size_t(tw);
+        for (int i = 0; i < tw; ++i) dst[i] = src[i - f];
+        for (int j = -f + 1; j <= f; ++j)
+          for (int i = 0; i < tw; ++i) dst[i] += src[i + j];
+      }
+      float* dist = m.dist[s][kind].data();
+      float* inv = m.invCount[s][kind].data();
+      for (int y = tile.y0; y < tile.y1; ++y) {
+        float* drow = dist + size_t(y - tile.y0) * size_t(tw);
+        float* irow = inv + size_t(y - tile.y0) * size_t(tw);
+        const float* first = m.rowSums.data() + size_t(y - tile.y0) * size_t(tw);
+        for (int i = 0; i < tw; ++i) drow[i] = first[i];
+        for (int j = 1; j <= 2 * f; ++j) {
+          const float* src = m.rowSums.data() + size_t(y - tile.y0 + j) * size_t(tw);
+          for (int i = 0; i < tw; ++i) drow[i] += src[i];
+        }
+        const int ny = overlap(y, f, loY[kind], hiY[kind]);
+        const float invY = ny > 0 ? 1.0f / float(ny) : 0.0f;
+        for (int i = 0; i < tw; ++i) {
+          irow[i] = invY * m.invCountX[size_t(i)];
+          drow[i] *= irow[i];
+        }
+      }
+    }
+  }
+
+  // Slopes where p is a neighbour in its own patch sums (offsets within the larger patch).
+  if (adx > G || ady > G) return;
+  for (int y = tile.y0; y < tile.y1; ++y) {
+    const size_t row = size_t(y - tile.y0) * size_t(tw);
+    const int x0 = tile.x0;
+    for (int c = 0; c < 3; ++c)
+      rdfc::nearColorSlopes(
+          tw, g_.row(c, y) + x0, g_.row(c, y + dy) + x0 + dx, g_.row(c, y - dy) + x0 - dx,
+          g_.row(c, y + 2 * dy) + x0 + 2 * dx, g_.row(c, y - 2 * dy) + x0 - 2 * dx,
+          vd_.row(c, y) + x0, vd_.row(c, y + dy) + x0 + dx, vd_.row(c, y - dy) + x0 - dx,
+          vd_.row(c, y + 2 * dy) + x0 + 2 * dx, vd_.row(c, y - 2 * dy) + x0 - 2 * dx,
+          m.mask[kPlus].data() + row, m.mask[kMinus].data() + row, m.mask[3].data() + row,
+          m.mask[4].data() + row, m.nearSlope[c][kPlus].data() + row,
+          m.nearSlope[c][kMinus].data() + row, m.nearSlope[c][kSym].data() + row);
+  }
+}
+
+void CandidateKernel::accumulate(const PixelRect& tile, int dx, int dy, TileMemory& m) const {
+  const int tw = tile.width(), x0 = tile.x0;
+  const size_t area = size_t(tile.area());
+  const int adx = std::abs(dx), ady = std::abs(dy);
+  for (int y = tile.y0; y < tile.y1; ++y) {
+    const size_t row = size_t(y - tile.y0) * size_t(tw);
+    const float* dataPlus[6];
+    const float* dataMinus[6];
+    for (int c = 0; c < 3; ++c) {
+      dataPlus[c] = b1_.row(c, y + dy) + x0 + dx;
+      dataPlus[3 + c] = b2_.row(c, y + dy) + x0 + dx;
+      dataMinus[c] = b1_.row(c, y - dy) + x0 - dx;
+      dataMinus[3 + c] = b2_.row(c, y - dy) + x0 - dx;
+    }
+    auto accumulateCandidate = [&](int s, const float* wPlus, const float* wMinus) {
+      rdfc::accumulateWeightSums(tw, wPlus, wMinus, m.weightSum[s].data() + row,
+                                 m.maxWeight[s].data() + row);
+      for (int k = 0; k < 6; ++k)
+        rdfc::accumulateData(tw, wPlus, wMinus, dataPlus[k], dataMinus[k],
+                             m.acc[s].data() + size_t(k) * area + row);
+    };
+    // THIRD: the feature weights alone.
+    accumulateCandidate(2, m.featPlus[1].data() + row, m.featMinus[1].data() + row);
+
+    for (int s = 0; s < kColor; ++s) {
+      const float* d[3] = {m.dist[s][kPlus].data() + row, m.dist[s][kMinus].data() + row,
+                           m.dist[s][kSym].data() + row};
+      const float* masks[3] = {m.mask[kPlus].data() + row, m.mask[kMinus].data() + row,
+                               m.mask[kSym].data() + row};
+      const float* fPlus = m.featPlus[0].data() + row;
+      const float* fMinus = m.featMinus[0].data() + row;
+      // Weights, then their derivatives with respect to each channel of y(p) (against the
+      // running maximum before this offset), then the sums.
+      rdfc::colorCandidateWeights(
+          tw, d[kPlus], d[kMinus], d[kSym], m.invCount[s][kPlus].data() + row,
+          m.invCount[s][kMinus].data() + row, m.invCount[s][kSym].data() + row, masks[kPlus],
+          masks[kMinus], masks[kSym], refineMinWeight_, fPlus, fMinus, m.maxWeight[s].data() + row,
+          m.wPlus.data(), m.wMinus.data(), m.terms);
+      const bool near = adx <= patch_[s] && ady <= patch_[s];
+      for (int c = 0; c < 3; ++c) {
+        const float* slope[3];
+        for (int kind = 0; kind < 3; ++kind) {
+          const float* centre = m.slope[c][kind].data() + row;
+          if (!near) {
+            slope[kind] = centre;
+            continue;
+          }
+          const float* nearby = m.nearSlope[c][kind].data() + row;
+          float* sum = m.combined[kind].data();
+          for (int i = 0; i < tw; ++i) sum[i] = centre[i] + nearby[i];
+          slope[kind] = sum;
+        }
+        const size_t k = size_t(c) * area + row;
+        rdfc::accumulateColorDerivative(
+            tw, m.terms, slope[kPlus], slope[kMinus], slope[kSym], g_.row(c, y + dy) + x0 + dx,
+            g_.row(c, y - dy) + x0 - dx, m.derivativeSum[s].data() + k,
+            m.derivativeAcc[s].data() + k, m.maxDerivative[s].data() + k);
+      }
+      accumulateCandidate(s, m.wPlus.data(), m.wMinus.data());
+    }
+  }
+}
+
+void CandidateKernel::finishTile(const PixelRect& tile, const TileMemory& m, Outputs& out) const {
+  const size_t area = size_t(tile.area());
+  for (int y = tile.y0; y < tile.y1; ++y)
+    for (int x = tile.x0; x < tile.x1; ++x) {
+      const size_t i = size_t(y - tile.y0) * size_t(tile.width()) + size_t(x - tile.x0);
+      for (int s = 0; s < 3; ++s) {
+        const float centre = std::max(m.maxWeight[s][i], kMinCenterWeight);
+        const float total = m.weightSum[s][i] + centre;
+        float mean[3];
+        for (int c = 0; c < 3; ++c) {
+          const float f1 = (m.acc[s][size_t(c) * area + i] + centre * b1_.row(c, y)[x]) / total;
+          const float f2 = (m.acc[s][size_t(3 + c) * area + i] + centre * b2_.row(c, y)[x]) / total;
+          out.buffer1[size_t(s)](x, y, c) = f1;
+          out.buffer2[size_t(s)](x, y, c) = f2;
+          mean[c] = 0.5f * (f1 + f2);
+        }
+        // ∂F_c/∂y_c = (∂A − F ∂S) / S with A = Σ w y(q) + w_centre y(p), S = Σ w + w_centre.
+        const float fallback = centre / total;
+        float der[3] = {fallback, fallback, fallback};
+        if (s < kColor) {
+          bool valid = true;
+          for (int c = 0; c < 3 && valid; ++c) {
+            const size_t k = size_t(c) * area + i;
+            const float dCentre =
+                m.maxWeight[s][i] >= kMinCenterWeight ? m.maxDerivative[s][k] : 0.0f;
+            const float dSum = m.derivativeSum[s][k] + dCentre;
+            const float dAcc = m.derivativeAcc[s][k] + dCentre * guide_(x, y, c) + centre;
+            der[c] = (dAcc - mean[c] * dSum) / total;
+            valid = std::isfinite(der[c]) &&
+                    (!params_.derivativeFallback || (der[c] >= 0.0f && der[c] <= 1.0f));
+          }
+          if (!valid) der[0] = der[1] = der[2] = fallback;
+        }
+        for (int c = 0; c < 3; ++c) out.derivative[size_t(s)](x, y, c) = der[c];
+      }
+    }
+}
+
+void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out) const {
+  const size_t area = size_t(tile.area());
+  const size_t grownArea = size_t(kTileWidth + 2 * grow_) * size_t(kTileHeight + 2 * grow_);
+  for (auto& v : m.mask) v.resize(area);
+  for (int set = 0; set < 2; ++set) {
+    m.featPlus[set].resize(area);
+    m.featMinus[set].resize(area);
+  }
+  for (auto& v : m.termRow) v.resize(kTileWidth);
+  for (auto& v : m.ext) v.resize(grownArea);
+  m.rowSums.resize(size_t(kTileWidth) * size_t(kTileHeight + 2 * grow_));
+  m.invCountX.resize(kTileWidth);
+  for (int s = 0; s < kColor; ++s)
+    for (int kind = 0; kind < 3; ++kind) {
+      m.dist[s][kind].resize(area);
+      m.invCount[s][kind].resize(area);
+    }
+  for (int c = 0; c < 3; ++c)
+    for (int kind = 0; kind < 3; ++kind) {
+      m.slope[c][kind].resize(area);
+      m.nearSlope[c][kind].resize(area);
+    }
+  for (auto& v : m.combined) v.resize(kTileWidth);
+  m.wPlus.resize(kTileWidth);
+  m.wMinus.resize(kTileWidth);
+  for (auto& v : m.termStore) v.resize(kTileWidth);
+  float** fields[13] = {&m.terms.w1,      &m.terms.w2,    &m.terms.ws,    &m.terms.k1,
+                        &m.terms.k2,      &m.terms.ks,    &m.terms.a,     &m.terms.sum,
+                        &m.terms.invSum2, &m.terms.pass1, &m.terms.pass2, &m.terms.pick1,
+                        &m.terms.pick2};
+  for (int f = 0; f < 13; ++f) *fields[f] = m.termStore[f].data();
+  for (int s = 0; s < 3; ++s) {
+    m.weightSum[s].assign(area, 0.0f);
+    m.maxWeight[s].assign(area, 0.0f);
+    m.acc[s].assign(6 * area, 0.0f);
+  }
+  for (int s = 0; s < kColor; ++s) {
+    m.derivativeSum[s].assign(3 * area, 0.0f);
+    m.derivativeAcc[s].assign(3 * area, 0.0f);
+    m.maxDerivative[s].assign(3 * area, 0.0f);
+  }
+  for (int dy = 0; dy <= params_.r; ++dy)
+    for (int dx = dy == 0 ? 1 : -params_.r; dx <= params_.r; ++dx) {
+      masks(tile, dx, dy, m);
+      featureWeights(tile, dx, dy, m);
+      colorDistances(tile, dx, dy, m);
+      accumulate(tile, dx, dy, m);
+    }
+  finishTile(tile, m, out);
+}
+
+std::array<RdfcCandidate, 3> CandidateKernel::run() const {
+  std::vector<PixelRect> tiles;
+  for (int y = 0; y < height_; y += kTileHeight)
+    for (int x = 0; x < width_; x += kTileWidth)
+      tiles.push_back({x, y, std::min(width_, x + kTileWidth), std::min(height_, y + kTileHeight)});
+  Outputs out;
+  for (int s = 0; s < 3; ++s) {
+    out.buffer1[size_t(s)] = Image(width_, height_, 3);
+    out.buffer2[size_t(s)] = Image(width_, height_, 3);
+    out.derivative[size_t(s)] = Image(width_, height_, 3);
+  }
+  tbb::enumerable_thread_specific<TileMemory> memory;
+  tbb::parallel_for(size_t(0), tiles.size(),
+                    [&](size_t t) { runTile(tiles[t], memory.local(), out); });
+
+  std::array<RdfcCandidate, 3> result;
+  for (int s = 0; s < 3; ++s) {
+    RdfcCandidate& cand = result[size_t(s)];
+    cand.buffer1 = std::move(out.buffer1[size_t(s)]);
+    cand.buffer2 = std::move(out.buffer2[size_t(s)]);
+    cand.derivative = std::move(out.derivative[size_t(s)]);
+    cand.mean = Image(width_, height_, 3);
+    cand.sure = Image(width_, height_, 1);
+    for (int y = 0; y < height_; ++y)
+      for (int x = 0; x < width_; ++x) {
+        float sum = 0.0f;
+        for (int c = 0; c < 3; ++c) {
+          const float f = 0.5f * (cand.buffer1(x, y, c) + cand.buffer2(x, y, c));
+          cand.mean(x, y, c) = f;
+          sum += sureTerm(f, guide_(x, y, c), variance_(x, y, c), cand.derivative(x, y, c));
+        }
+        cand.sure(x, y, 0) = std::isfinite(sum) ? sum / 3.0f : std::numeric_limits<float>::max();
+      }
+  }
+  return result;
+}
+
+}  // namespace
+
+std::array<RdfcCandidate, 3> rdfcCandidates(const Image& buffer1, const Image& buffer2,
+                                            const Image& colorVariance,
+                                            const std::vector<RdfcFeature>& features,
+                                            const RdfcCandidateParams& params) {
+  return CandidateKernel(buffer1, buffer2, colorVariance, features, params).run();
+}
+
+}  // namespace chorus

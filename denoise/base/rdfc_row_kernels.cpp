@@ -1,0 +1,228 @@
+#include "denoise/base/rdfc_row_kernels.h"
+
+// Floating-point operations never trap here (no FP exceptions are enabled in chorus), which lets
+// GCC turn the selects of these loops (clamps, refinement) into vector blends. It changes no
+// result: the same IEEE operations are evaluated.
+#pragma GCC optimize("no-trapping-math")
+
+#include <algorithm>
+
+#include "denoise/base/filters/fast_exp.h"
+
+// AVX2 and baseline builds of every kernel (GCC function multiversioning through ifunc).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define RDFC_KERNEL __attribute__((target_clones("avx2", "default")))
+#else
+#define RDFC_KERNEL
+#endif
+
+namespace chorus::rdfc {
+namespace {
+
+constexpr float kEpsilon = 1e-10f;
+constexpr float kClamp = 1e4f;  // NlMeansTerm's default distance clamp
+constexpr float kThird = 1.0f / 3.0f;
+constexpr float kThirdClamp = kClamp * kThird;  // a channel's clamped share
+
+inline float clampDistance(float d) {
+  return d <= kClamp ? d : kClamp;
+}
+// exp(−max(0, d)), 0 for d ≥ 87 and for NaN (as expNonPositive, which returns 0 below −87).
+inline float weightOf(float d) {
+  const float clamped = d < 87.0f ? (d > 0.0f ? d : 0.0f) : 87.0f;
+  return expClamped(-clamped) * float(d < 87.0f);
+}
+
+// Symmetric-pair refinement factor a (0 where it does not apply).
+inline float refineFactor(float w1, float w2, float ws, float mask, float minWeight) {
+  const float a = std::min(std::max(ws / (w1 + w2) - 1.0f, 0.0f), 1.0f);
+  return (mask > 0.0f) & (w1 >= minWeight) & (w2 >= minWeight) ? a : 0.0f;
+}
+
+}  // namespace
+
+RDFC_KERNEL
+void addPairDistance(int n, const float* __restrict f, const float* __restrict fq,
+                     const float* __restrict vn, const float* __restrict vnq,
+                     const float* __restrict denA, const float* __restrict denAq,
+                     const float* __restrict denB, const float* __restrict denBq,
+                     float* __restrict outA, float* __restrict outB) {
+  for (int i = 0; i < n; ++i) {
+    const float diff = f[i] - fq[i];
+    const float num = diff * diff - (vn[i] + std::min(vn[i], vnq[i]));
+    outA[i] += clampDistance(num / (denA[i] + denAq[i] + kEpsilon));
+    outB[i] += clampDistance(num / (denB[i] + denBq[i] + kEpsilon));
+  }
+}
+
+RDFC_KERNEL
+void addSymmetricDistance(int n, const float* __restrict f, const float* __restrict fp,
+                          const float* __restrict fm, const float* __restrict vn,
+                          const float* __restrict vnp, const float* __restrict vnm,
+                          const float* __restrict denA, const float* __restrict denAp,
+                          const float* __restrict denAm, const float* __restrict denB,
+                          const float* __restrict denBp, const float* __restrict denBm,
+                          float* __restrict outA, float* __restrict outB) {
+  for (int i = 0; i < n; ++i) {
+    const float diff = f[i] - 0.5f * (fp[i] + fm[i]);
+    const float num =
+        diff * diff - (vn[i] + 0.25f * (std::min(vn[i], vnp[i]) + std::min(vn[i], vnm[i])));
+    outA[i] += clampDistance(num / (denA[i] + 0.25f * (denAp[i] + denAm[i]) + kEpsilon));
+    outB[i] += clampDistance(num / (denB[i] + 0.25f * (denBp[i] + denBm[i]) + kEpsilon));
+  }
+}
+
+RDFC_KERNEL
+void minTermWeights(int n, float scale, const float* __restrict dPlus,
+                    const float* __restrict dMinus, const float* __restrict dSym,
+                    const float* __restrict symMask, float minRefineWeight,
+                    float* __restrict outPlus, float* __restrict outMinus) {
+  for (int i = 0; i < n; ++i) {
+    const float w1 = weightOf(scale * dPlus[i]), w2 = weightOf(scale * dMinus[i]);
+    const float ws = weightOf(scale * dSym[i]);
+    const float a = refineFactor(w1, w2, ws, symMask[i], minRefineWeight);
+    outPlus[i] = std::min(outPlus[i], a * ws + (1.0f - a) * w1);
+    outMinus[i] = std::min(outMinus[i], a * ws + (1.0f - a) * w2);
+  }
+}
+
+RDFC_KERNEL
+void addColorDistances(int n, const float* __restrict g, const float* __restrict gp,
+                       const float* __restrict gm, const float* __restrict vn,
+                       const float* __restrict vnp, const float* __restrict vnm,
+                       const float* __restrict vd, const float* __restrict vdp,
+                       const float* __restrict vdm, float* __restrict plus, float* __restrict minus,
+                       float* __restrict sym, float* __restrict sPlus, float* __restrict sMinus,
+                       float* __restrict sSym) {
+  for (int i = 0; i < n; ++i) {
+    const float mp = std::min(vn[i], vnp[i]), mm = std::min(vn[i], vnm[i]);
+    const float diffP = g[i] - gp[i], diffM = g[i] - gm[i];
+    const float diffS = g[i] - 0.5f * (gp[i] + gm[i]);
+    const float invP = 1.0f / (vd[i] + vdp[i] + kEpsilon);
+    const float invM = 1.0f / (vd[i] + vdm[i] + kEpsilon);
+    const float invS = 1.0f / (vd[i] + 0.25f * (vdp[i] + vdm[i]) + kEpsilon);
+    const float dp = kThird * ((diffP * diffP - (vn[i] + mp)) * invP);
+    const float dm = kThird * ((diffM * diffM - (vn[i] + mm)) * invM);
+    const float ds = kThird * ((diffS * diffS - (vn[i] + 0.25f * (mp + mm))) * invS);
+    plus[i] += dp <= kThirdClamp ? dp : kThirdClamp;
+    minus[i] += dm <= kThirdClamp ? dm : kThirdClamp;
+    sym[i] += ds <= kThirdClamp ? ds : kThirdClamp;
+  }
+  if (!sPlus) return;
+  for (int i = 0; i < n; ++i) {
+    // d/dg(p) of diff² · inv = 2 diff · inv
+    const float diffP = g[i] - gp[i], diffM = g[i] - gm[i];
+    const float diffS = g[i] - 0.5f * (gp[i] + gm[i]);
+    sPlus[i] = 2.0f * kThird * diffP / (vd[i] + vdp[i] + kEpsilon);
+    sMinus[i] = 2.0f * kThird * diffM / (vd[i] + vdm[i] + kEpsilon);
+    sSym[i] = 2.0f * kThird * diffS / (vd[i] + 0.25f * (vdp[i] + vdm[i]) + kEpsilon);
+  }
+}
+
+RDFC_KERNEL
+void nearColorSlopes(int n, const float* __restrict g, const float* __restrict gp,
+                     const float* __restrict gm, const float* __restrict g2p,
+                     const float* __restrict g2m, const float* __restrict vd,
+                     const float* __restrict vdp, const float* __restrict vdm,
+                     const float* __restrict vd2p, const float* __restrict vd2m,
+                     const float* __restrict maskPlusPair, const float* __restrict maskMinusPair,
+                     const float* __restrict maskBehind, const float* __restrict maskAhead,
+                     float* __restrict nearPlus, float* __restrict nearMinus,
+                     float* __restrict nearSym) {
+  for (int i = 0; i < n; ++i) {
+    // Pair (a, p): d/dg(p) of (g(a) − g(p))² · inv = −2 (g(a) − g(p)) · inv.
+    const float plusPair = -2.0f * kThird * (gm[i] - g[i]) / (vdm[i] + vd[i] + kEpsilon);
+    const float minusPair = -2.0f * kThird * (gp[i] - g[i]) / (vdp[i] + vd[i] + kEpsilon);
+    // Symmetric distance of a with p one of its two neighbours: d/dg(p) of
+    // (g(a) − (g(b) + g(c))/2)² · inv = −(g(a) − (g(b) + g(c))/2) · inv.
+    const float sb = gm[i] - 0.5f * (g[i] + g2m[i]), sa = gp[i] - 0.5f * (g2p[i] + g[i]);
+    const float behind = -kThird * sb / (vdm[i] + 0.25f * (vd[i] + vd2m[i]) + kEpsilon);
+    const float ahead = -kThird * sa / (vdp[i] + 0.25f * (vd2p[i] + vd[i]) + kEpsilon);
+    nearPlus[i] = maskMinusPair[i] * plusPair;
+    nearMinus[i] = maskPlusPair[i] * minusPair;
+    nearSym[i] = maskBehind[i] * behind + maskAhead[i] * ahead;
+  }
+}
+
+RDFC_KERNEL
+void colorCandidateWeights(int n, const float* __restrict dPlus, const float* __restrict dMinus,
+                           const float* __restrict dSym, const float* __restrict invCountPlus,
+                           const float* __restrict invCountMinus,
+                           const float* __restrict invCountSym, const float* __restrict maskPlus,
+                           const float* __restrict maskMinus, const float* __restrict maskSym,
+                           float minRefineWeight, const float* __restrict fPlus,
+                           const float* __restrict fMinus, const float* __restrict maxWeight,
+                           float* __restrict vPlus, float* __restrict vMinus, float* __restrict tw1,
+                           float* __restrict tw2, float* __restrict tws, float* __restrict tk1,
+                           float* __restrict tk2, float* __restrict tks, float* __restrict ta,
+                           float* __restrict tsum, float* __restrict tinv, float* __restrict tp1,
+                           float* __restrict tp2, float* __restrict tq1, float* __restrict tq2) {
+  for (int i = 0; i < n; ++i) {
+    const float w1 = maskPlus[i] * weightOf(dPlus[i]), w2 = maskMinus[i] * weightOf(dMinus[i]);
+    const float ws = weightOf(dSym[i]);
+    const float sum = w1 + w2, t = ws / sum - 1.0f;
+    const float a = refineFactor(w1, w2, ws, maskSym[i], minRefineWeight);
+    const float r1 = a * ws + (1.0f - a) * w1, r2 = a * ws + (1.0f - a) * w2;
+    const float v1 = std::min(r1, fPlus[i]), v2 = std::min(r2, fMinus[i]);
+    const float m = maxWeight[i];
+    const float pick2 = float((v2 > m) & (v2 > v1));
+    const float inv = 1.0f / (sum * sum + 1e-30f);  // finite; sum ≥ 2e^−25 where refining
+    vPlus[i] = v1;
+    vMinus[i] = v2;
+    tw1[i] = w1;
+    tw2[i] = w2;
+    tws[i] = ws;
+    tk1[i] = -w1 * invCountPlus[i] * float(dPlus[i] > 0.0f);
+    tk2[i] = -w2 * invCountMinus[i] * float(dMinus[i] > 0.0f);
+    tks[i] = -ws * invCountSym[i] * float(dSym[i] > 0.0f);
+    ta[i] = a;
+    tsum[i] = sum;
+    tinv[i] = float((a > 0.0f) & (t < 1.0f)) * inv;
+    tp1[i] = float(r1 < fPlus[i]);
+    tp2[i] = float(r2 < fMinus[i]);
+    tq1[i] = float(v1 > m) * (1.0f - pick2);
+    tq2[i] = pick2;
+  }
+}
+
+RDFC_KERNEL
+void accumulateColorDerivative(int n, const float* __restrict tw1, const float* __restrict tw2,
+                               const float* __restrict tws, const float* __restrict tk1,
+                               const float* __restrict tk2, const float* __restrict tks,
+                               const float* __restrict ta, const float* __restrict tsum,
+                               const float* __restrict tinv, const float* __restrict tp1,
+                               const float* __restrict tp2, const float* __restrict tq1,
+                               const float* __restrict tq2, const float* __restrict slopePlus,
+                               const float* __restrict slopeMinus, const float* __restrict slopeSym,
+                               const float* __restrict gPlus, const float* __restrict gMinus,
+                               float* __restrict derivativeSum, float* __restrict derivativeAcc,
+                               float* __restrict maxDerivative) {
+  for (int i = 0; i < n; ++i) {
+    const float dw1 = tk1[i] * slopePlus[i], dw2 = tk2[i] * slopeMinus[i];
+    const float dws = tks[i] * slopeSym[i];
+    const float a = ta[i], ws = tws[i];
+    const float da = (dws * tsum[i] - ws * (dw1 + dw2)) * tinv[i];
+    const float dv1 = tp1[i] * (da * (ws - tw1[i]) + a * dws + (1.0f - a) * dw1);
+    const float dv2 = tp2[i] * (da * (ws - tw2[i]) + a * dws + (1.0f - a) * dw2);
+    derivativeSum[i] += dv1 + dv2;
+    derivativeAcc[i] += dv1 * gPlus[i] + dv2 * gMinus[i];
+    maxDerivative[i] = tq2[i] * dv2 + tq1[i] * dv1 + (1.0f - tq1[i] - tq2[i]) * maxDerivative[i];
+  }
+}
+
+RDFC_KERNEL
+void accumulateWeightSums(int n, const float* __restrict wPlus, const float* __restrict wMinus,
+                          float* __restrict weightSum, float* __restrict maxWeight) {
+  for (int i = 0; i < n; ++i) {
+    weightSum[i] += wPlus[i] + wMinus[i];
+    maxWeight[i] = std::max(maxWeight[i], std::max(wPlus[i], wMinus[i]));
+  }
+}
+
+RDFC_KERNEL
+void accumulateData(int n, const float* __restrict wPlus, const float* __restrict wMinus,
+                    const float* __restrict up, const float* __restrict um, float* __restrict acc) {
+  for (int i = 0; i < n; ++i) acc[i] += wPlus[i] * up[i] + wMinus[i] * um[i];
+}
+
+}  // namespace chorus::rdfc

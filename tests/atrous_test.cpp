@@ -130,6 +130,38 @@ TEST(Atrous, VectorKernelsMatchTheScalarKernelBitForBit) {
     }
 }
 
+// A light seen directly, recorded as in the chorus renderer: black albedo, bright colour, and a
+// row of pixels mixing light and wall samples (mid albedo, huge variance) below it.
+TEST(Atrous, DemodulationDoesNotLeakEmittersWithBlackAlbedo) {
+  const test::SyntheticScene scene = scene64();
+  DenoiseInput input = scene.fullInput();
+  Image truth = scene.truth;
+  SubBuffer& b = input.whole;
+  for (int y = 10; y <= 20; ++y)
+    for (int x = 20; x < 40; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const bool mixed = y == 20;
+        const float light = 50.0f, wall = scene.truth(x, 21, c);
+        truth(x, y, c) = mixed ? 0.5f * (light + wall) : light;
+        b.color.mean(x, y, c) = mixed ? (c == 1 ? 0.3f * light : 0.7f * light) : light;
+        b.color.varianceOfMean(x, y, c) = mixed ? 0.25f * light * light / 16 : 0.0f;
+        b.albedo.mean(x, y, c) = mixed ? 0.5f * scene.albedo(x, 21, c) : 0.0f;
+      }
+  Image ring(64, 64, 1);  // wall pixels within 3 of the light
+  for (int y = 21; y <= 23; ++y)
+    for (int x = 17; x < 43; ++x) ring(x, y, 0) = 1.0f;
+  const double noisy = test::maskedRelMse(b.color.mean, truth, ring);
+  const double denoised = test::maskedRelMse(Atrous().run(input), truth, ring);
+  AtrousParams plain;
+  plain.demodulate = false;
+  const double notDemodulated = test::maskedRelMse(Atrous(plain).run(input), truth, ring);
+  std::cout << "next to the light: relMSE noisy " << noisy << ", atrous " << denoised
+            << ", not demodulated " << notDemodulated << "\n";
+  // Measured: 0.095 (0.05 noisy, 0.81 not demodulated); 2.1 without the emitter guard.
+  EXPECT_LT(denoised, 2 * noisy);
+  EXPECT_LT(denoised * 4, notDemodulated);
+}
+
 TEST(Atrous, NonFiniteInputsGiveFiniteOutputs) {
   const test::SyntheticScene scene = scene64();
   DenoiseInput input = scene.fullInput();

@@ -16,7 +16,9 @@
 //   - luminance a = (0.2126, 0.7152, 0.0722); Var_l = (Σ_c a_c √V_c)² from the per-channel
 //     variances of the mean (channels are positively correlated; Σ a_c² V_c under-estimates);
 //   - optional albedo demodulation: colour and its variance divided by max(albedo, 1e-3) (and
-//     its square) before filtering, the result multiplied back after;
+//     its square) before filtering, the result multiplied back after — except within one pixel
+//     of a pixel whose albedo is below 0.02 in every channel (a light seen directly records a
+//     black albedo in chorus's buffers; demodulated, its mixed edge pixels would leak);
 //   - optional firefly clamp (preview only, biased): luminance limited to 10× its 3×3 median.
 #include <string>
 

@@ -1,19 +1,17 @@
 #include "denoise/base/rdfc.h"
 
 #include <cmath>
-#include <optional>
+#include <span>
 #include <string>
 
 #include "denoise/base/buffer_variance.h"
-#include "denoise/base/filters/nlmeans_filter.h"
-#include "denoise/base/min_weights_filter.h"
+#include "denoise/base/feature_nlmeans.h"
 #include "denoise/util/error.h"
 
 namespace chorus {
 namespace {
 
 constexpr float kMinCenterWeight = 1e-3f;
-constexpr float kSymmetricLimit = 25.0f;
 
 void requireRange(bool ok, const std::string& what) {
   if (!ok) throw Error("rdfc: " + what);
@@ -25,41 +23,26 @@ Image average(const Image& a, const Image& b) {
   return out;
 }
 
-// A Rousselle NL-means term (α = 1, ε = 1e-10, channel average, symmetric refinement).
-NlMeansTerm rdfcTerm(const Image& guide, const Image& variance, int f, float k) {
-  NlMeansTerm term;
-  term.guide = &guide;
-  term.variance = &variance;
-  term.f = f;
-  term.k = k;
-  term.alpha = 1.0f;
-  term.epsilon = 1e-10f;
-  term.channels = ChannelWeights::AverageDistance;
-  term.symmetricRefinement = true;
-  term.symmetricDistanceLimit = kSymmetricLimit;
-  return term;
-}
-
-NlMeansParams rdfcWindow(int r, int boxRadius) {
-  NlMeansParams params;
-  params.r = r;
-  params.weightBoxRadius = boxRadius;
-  params.center = CenterWeight::MaxOfNeighbours;
-  params.minCenterWeight = kMinCenterWeight;
-  return params;
+// Colour-guided NL-means without features (RDFC's selection smoothing): patch radius f, k,
+// weights boxed over boxRadius, window r.
+std::vector<Image> colorNlMeans(std::span<const Image* const> data, const Image& guide,
+                                const Image& variance, const RdfcParams& params, int r) {
+  const PatchTerm patch{.guide = &guide,
+                        .variance = &variance,
+                        .f = params.selectionF,
+                        .k = params.selectionK,
+                        .weightBoxRadius = params.selectionBoxRadius};
+  return featureNlMeans(data, &patch, {}, {.r = r, .minCenterWeight = kMinCenterWeight});
 }
 
 // Step 4: smoothed SURE maps, argmin with RDFC's rules, smoothed binary maps.
 void selectCandidates(const Image& guide, const Image& variance, const RdfcParams& params,
                       RdfcResult& result) {
   const int w = guide.width(), h = guide.height();
-  const NlMeansTerm term = rdfcTerm(guide, variance, params.selectionF, params.selectionK);
-  const NlMeansWeights sureWeights(term, rdfcWindow(params.sureR, params.selectionBoxRadius));
   const Image* sure[] = {&result.candidates[0].sure, &result.candidates[1].sure,
                          &result.candidates[2].sure};
-  NlMeansFilterResult smoothed = nlMeansFilterAll(sure, sureWeights);
-  for (int s = 0; s < 3; ++s)
-    result.smoothedSure[size_t(s)] = std::move(smoothed.filtered[size_t(s)]);
+  std::vector<Image> smoothed = colorNlMeans(sure, guide, variance, params, params.sureR);
+  for (int s = 0; s < 3; ++s) result.smoothedSure[size_t(s)] = std::move(smoothed[size_t(s)]);
 
   result.selection = Image(w, h, 1);
   std::array<Image, 3> binary = {Image(w, h, 1), Image(w, h, 1), Image(w, h, 1)};
@@ -82,11 +65,9 @@ void selectCandidates(const Image& guide, const Image& variance, const RdfcParam
       binary[size_t(best)](x, y, 0) = 1.0f;
     }
 
-  const NlMeansWeights mapWeights(term, rdfcWindow(params.selectionR, params.selectionBoxRadius));
   const Image* maps[] = {&binary[0], &binary[1], &binary[2]};
-  NlMeansFilterResult soft = nlMeansFilterAll(maps, mapWeights);
-  for (int s = 0; s < 3; ++s)
-    result.selectionWeights[size_t(s)] = std::move(soft.filtered[size_t(s)]);
+  std::vector<Image> soft = colorNlMeans(maps, guide, variance, params, params.selectionR);
+  for (int s = 0; s < 3; ++s) result.selectionWeights[size_t(s)] = std::move(soft[size_t(s)]);
 }
 
 // Σ W_s F_s / Σ W_s for one buffer (the selected candidate where the weights vanish).
@@ -115,28 +96,26 @@ Image secondPass(const Image& first1, const Image& first2, const std::vector<Rdf
                  const RdfcParams& params) {
   const Image guide = average(first1, first2);
   const Image variance = smooth3Tap(squaredDifference(first1, first2, 0.25f), std::exp(-2.0f));
-  NlMeansTerm colorTerm = rdfcTerm(guide, variance, params.secondF, params.secondKc);
-  colorTerm.centerOnlyDenominator = true;
-  const NlMeansWeights colorWeights(colorTerm, rdfcWindow(params.secondR, params.secondBoxRadius));
-
-  std::vector<const NlMeansWeights*> weights = {&colorWeights};
+  const PatchTerm patch{.guide = &guide,
+                        .variance = &variance,
+                        .f = params.secondF,
+                        .k = params.secondKc,
+                        .centerOnlyDenominator = true,
+                        .weightBoxRadius = params.secondBoxRadius};
   std::vector<Image> normalizing;
   normalizing.reserve(features.size());
-  std::vector<NlMeansTerm> featureTerms;
+  std::vector<FeatureTerm> featureTerms;
   for (const RdfcFeature& f : features) {
     normalizing.push_back(f.normalizingVariance(params.secondTau));
-    NlMeansTerm term = rdfcTerm(f.value, f.variance, 0, params.secondKf);
-    term.denominatorVariance = &normalizing.back();
-    term.centerOnlyDenominator = true;
-    featureTerms.push_back(term);
-  }
-  std::optional<NlMeansWeights> featureWeights;
-  if (!featureTerms.empty()) {
-    featureWeights.emplace(featureTerms, rdfcWindow(params.secondR, 0));
-    weights.push_back(&*featureWeights);
+    featureTerms.push_back({.value = &f.value,
+                            .variance = &f.variance,
+                            .normalizingVariance = &normalizing.back(),
+                            .k = params.secondKf,
+                            .centerOnlyDenominator = true});
   }
   const Image* data[] = {&first1, &first2};
-  const std::vector<Image> filtered = nlMeansFilterMin(data, weights, kMinCenterWeight);
+  const std::vector<Image> filtered = featureNlMeans(
+      data, &patch, featureTerms, {.r = params.secondR, .minCenterWeight = kMinCenterWeight});
   return average(filtered[0], filtered[1]);
 }
 

@@ -9,8 +9,10 @@
 #include <stdexcept>
 
 #include "denoise/base/filters/pixel_rect.h"
-#include "denoise/base/rdfc_row_kernels.h"
+#include "denoise/base/nlmeans_row_kernels.h"
+#include "denoise/base/padded_planes.h"
 #include "denoise/base/sure.h"
+#include "denoise/util/float_lanes.h"
 
 namespace chorus {
 namespace {
@@ -21,39 +23,6 @@ constexpr float kSymmetricLimit = 25.0f;   // refine only where both distances a
 constexpr int kColor = 2;                  // FIRST and SECOND have a colour term
 enum Kind { kPlus, kMinus, kSym };
 
-// Planar copy with a zero border, so the row kernels may read any neighbour within `pad`.
-class PaddedPlanes {
- public:
-  PaddedPlanes() = default;
-  PaddedPlanes(int width, int height, int channels, int pad)
-      : pad_(pad),
-        stride_(size_t(width + 2 * pad)),
-        planeSize_(stride_ * size_t(height + 2 * pad)),
-        data_(planeSize_ * size_t(channels), 0.0f) {}
-  // Channel c of this ← channel sourceChannel of image × scale.
-  void set(int c, const Image& image, int sourceChannel, float scale) {
-    for (int y = 0; y < image.height(); ++y)
-      for (int x = 0; x < image.width(); ++x)
-        mutableRow(c, y)[x] = scale * image(x, y, sourceChannel);
-  }
-  float* mutableRow(int c, int y) {
-    return data_.data() + size_t(c) * planeSize_ + size_t(y + pad_) * stride_ + size_t(pad_);
-  }
-  const float* row(int c, int y) const {
-    return data_.data() + size_t(c) * planeSize_ + size_t(y + pad_) * stride_ + size_t(pad_);
-  }
-
- private:
-  int pad_ = 0;
-  size_t stride_ = 0, planeSize_ = 0;
-  std::vector<float> data_;
-};
-
-// Patch offsets o ∈ [−f, f] along one axis with x + o in [lo, hi).
-int overlap(int x, int f, int lo, int hi) {
-  return std::max(0, std::min(x + f + 1, hi) - std::max(x - f, lo));
-}
-
 struct TileMemory {
   std::vector<float> mask[5];  // plus, minus, sym, behind (p−δ, p−2δ), ahead (p+δ, p+2δ)
   std::vector<float> featPlus[2], featMinus[2];  // feature weights, τ sets FIRST/SECOND, THIRD
@@ -63,8 +32,8 @@ struct TileMemory {
   std::vector<float> dist[kColor][3], invCount[kColor][3];
   std::vector<float> slope[3][3], nearSlope[3][3], combined[3];  // [channel][kind]
   std::vector<float> wPlus, wMinus;
-  std::vector<float> termStore[13];  // rows of rdfc::ColorWeightTerms
-  rdfc::ColorWeightTerms terms;
+  std::vector<float> termStore[13];  // rows of rows::ColorWeightTerms
+  rows::ColorWeightTerms terms;
   // Accumulators, per candidate: Σw, max w, Σ w b1 (3 planes), Σ w b2 (3 planes); per colour
   // candidate and channel of y(p): Σ ∂w, Σ ∂w y(q), ∂(max w).
   std::vector<float> weightSum[3], maxWeight[3], acc[3];
@@ -188,16 +157,16 @@ void CandidateKernel::featureWeights(const PixelRect& tile, int dx, int dy, Tile
         const float* b = fDen_[1].row(k, y) + x0;
         const float* bp = fDen_[1].row(k, y + dy) + x0 + dx;
         const float* bm = fDen_[1].row(k, y - dy) + x0 - dx;
-        rdfc::addPairDistance(tw, f, fp, n, np, a, ap, b, bp, m.termRow[0].data(),
+        rows::addPairDistance(tw, f, fp, n, np, a, ap, b, bp, m.termRow[0].data(),
                               m.termRow[3].data());
-        rdfc::addPairDistance(tw, f, fm, n, nm, a, am, b, bm, m.termRow[1].data(),
+        rows::addPairDistance(tw, f, fm, n, nm, a, am, b, bm, m.termRow[1].data(),
                               m.termRow[4].data());
-        rdfc::addSymmetricDistance(tw, f, fp, fm, n, np, nm, a, ap, am, b, bp, bm,
+        rows::addSymmetricDistance(tw, f, fp, fm, n, np, nm, a, ap, am, b, bp, bm,
                                    m.termRow[2].data(), m.termRow[5].data());
       }
       const float scale = 1.0f / float(termBegin_[term + 1] - termBegin_[term]);
       for (int set = 0; set < 2; ++set)
-        rdfc::minTermWeights(tw, scale, m.termRow[3 * set].data(), m.termRow[3 * set + 1].data(),
+        rows::minTermWeights(tw, scale, m.termRow[3 * set].data(), m.termRow[3 * set + 1].data(),
                              m.termRow[3 * set + 2].data(), m.mask[kSym].data() + row,
                              refineMinWeight_, m.featPlus[set].data() + row,
                              m.featMinus[set].data() + row);
@@ -227,12 +196,12 @@ void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, Tile
         const size_t e = size_t(ey) * size_t(ew) + size_t(xa - ex0);
         const bool withSlope = tileRow && seg == 1;
         const size_t t = size_t(y - tile.y0) * size_t(tw);
-        rdfc::addColorDistances(
+        rows::addColorDistances(
             n, g_.row(c, y) + xa, g_.row(c, y + dy) + xa + dx, g_.row(c, y - dy) + xa - dx,
             vn_.row(c, y) + xa, vn_.row(c, y + dy) + xa + dx, vn_.row(c, y - dy) + xa - dx,
             vd_.row(c, y) + xa, vd_.row(c, y + dy) + xa + dx, vd_.row(c, y - dy) + xa - dx,
-            m.ext[kPlus].data() + e, m.ext[kMinus].data() + e, m.ext[kSym].data() + e,
-            withSlope ? m.slope[c][kPlus].data() + t : nullptr,
+            1.0f / 3.0f, 0.25f, m.ext[kPlus].data() + e, m.ext[kMinus].data() + e,
+            m.ext[kSym].data() + e, withSlope ? m.slope[c][kPlus].data() + t : nullptr,
             withSlope ? m.slope[c][kMinus].data() + t : nullptr,
             withSlope ? m.slope[c][kSym].data() + t : nullptr);
       }
@@ -264,7 +233,7 @@ void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, Tile
     for (int kind = 0; kind < 3; ++kind) {
       const std::vector<float>& e = m.ext[kind];
       for (int i = 0; i < tw; ++i) {
-        const int nx = overlap(tile.x0 + i, f, loX[kind], hiX[kind]);
+        const int nx = boxOverlap(tile.x0 + i, f, loX[kind], hiX[kind]);
         m.invCountX[size_t(i)] = nx > 0 ? 1.0f / float(nx) : 0.0f;
       }
       // Horizontal sums for the rows [tile.y0 − f, tile.y1 + f), tile columns.
@@ -286,7 +255,7 @@ void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, Tile
           const float* src = m.rowSums.data() + size_t(y - tile.y0 + j) * size_t(tw);
           for (int i = 0; i < tw; ++i) drow[i] += src[i];
         }
-        const int ny = overlap(y, f, loY[kind], hiY[kind]);
+        const int ny = boxOverlap(y, f, loY[kind], hiY[kind]);
         const float invY = ny > 0 ? 1.0f / float(ny) : 0.0f;
         for (int i = 0; i < tw; ++i) {
           irow[i] = invY * m.invCountX[size_t(i)];
@@ -302,7 +271,7 @@ void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, Tile
     const size_t row = size_t(y - tile.y0) * size_t(tw);
     const int x0 = tile.x0;
     for (int c = 0; c < 3; ++c)
-      rdfc::nearColorSlopes(
+      rows::nearColorSlopes(
           tw, g_.row(c, y) + x0, g_.row(c, y + dy) + x0 + dx, g_.row(c, y - dy) + x0 - dx,
           g_.row(c, y + 2 * dy) + x0 + 2 * dx, g_.row(c, y - 2 * dy) + x0 - 2 * dx,
           vd_.row(c, y) + x0, vd_.row(c, y + dy) + x0 + dx, vd_.row(c, y - dy) + x0 - dx,
@@ -328,10 +297,10 @@ void CandidateKernel::accumulate(const PixelRect& tile, int dx, int dy, TileMemo
       dataMinus[3 + c] = b2_.row(c, y - dy) + x0 - dx;
     }
     auto accumulateCandidate = [&](int s, const float* wPlus, const float* wMinus) {
-      rdfc::accumulateWeightSums(tw, wPlus, wMinus, m.weightSum[s].data() + row,
+      rows::accumulateWeightSums(tw, wPlus, wMinus, m.weightSum[s].data() + row,
                                  m.maxWeight[s].data() + row);
       for (int k = 0; k < 6; ++k)
-        rdfc::accumulateData(tw, wPlus, wMinus, dataPlus[k], dataMinus[k],
+        rows::accumulateData(tw, wPlus, wMinus, dataPlus[k], dataMinus[k],
                              m.acc[s].data() + size_t(k) * area + row);
     };
     // THIRD: the feature weights alone.
@@ -346,7 +315,7 @@ void CandidateKernel::accumulate(const PixelRect& tile, int dx, int dy, TileMemo
       const float* fMinus = m.featMinus[0].data() + row;
       // Weights, then their derivatives with respect to each channel of y(p) (against the
       // running maximum before this offset), then the sums.
-      rdfc::colorCandidateWeights(
+      rows::colorCandidateWeights(
           tw, d[kPlus], d[kMinus], d[kSym], m.invCount[s][kPlus].data() + row,
           m.invCount[s][kMinus].data() + row, m.invCount[s][kSym].data() + row, masks[kPlus],
           masks[kMinus], masks[kSym], refineMinWeight_, fPlus, fMinus, m.maxWeight[s].data() + row,
@@ -366,7 +335,7 @@ void CandidateKernel::accumulate(const PixelRect& tile, int dx, int dy, TileMemo
           slope[kind] = sum;
         }
         const size_t k = size_t(c) * area + row;
-        rdfc::accumulateColorDerivative(
+        rows::accumulateColorDerivative(
             tw, m.terms, slope[kPlus], slope[kMinus], slope[kSym], g_.row(c, y + dy) + x0 + dx,
             g_.row(c, y - dy) + x0 - dx, m.derivativeSum[s].data() + k,
             m.derivativeAcc[s].data() + k, m.maxDerivative[s].data() + k);
@@ -415,6 +384,7 @@ void CandidateKernel::finishTile(const PixelRect& tile, const TileMemory& m, Out
 }
 
 void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out) const {
+  const FlushDenormals flush;  // tiny weights times data would be denormal
   const size_t area = size_t(tile.area());
   const size_t grownArea = size_t(kTileWidth + 2 * grow_) * size_t(kTileHeight + 2 * grow_);
   for (auto& v : m.mask) v.resize(area);

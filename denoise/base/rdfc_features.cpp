@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "denoise/base/buffer_variance.h"
-#include "denoise/base/filters/nlmeans_filter.h"
+#include "denoise/base/feature_nlmeans.h"
 
 namespace chorus {
 namespace {
@@ -66,26 +66,16 @@ RdfcFeature prefilter(const std::string& name, const MappedFeature& whole,
       for (int c = 0; c < channels; ++c)
         variance.data()[i * size_t(channels) + size_t(c)] = std::nanf("");
 
-  NlMeansTerm term;
-  term.guide = &guide;
-  term.variance = &variance;
-  term.f = params.f;
-  term.k = params.k;
-  term.alpha = 1.0f;
-  term.epsilon = 1e-10f;
-  term.channels = ChannelWeights::AverageDistance;
-  term.symmetricRefinement = true;
-  term.symmetricDistanceLimit = 25.0f;
-  NlMeansParams nlm;
-  nlm.r = params.r;
-  nlm.weightBoxRadius = params.weightBoxRadius;
-  nlm.center = CenterWeight::MaxOfNeighbours;
-  nlm.minCenterWeight = 1e-3f;
-  const NlMeansWeights weights(term, nlm);
+  const PatchTerm patch{.guide = &guide,
+                        .variance = &variance,
+                        .f = params.f,
+                        .k = params.k,
+                        .weightBoxRadius = params.weightBoxRadius};
   const Image* data[] = {&f1, &f2};
-  const NlMeansFilterResult filtered = nlMeansFilterAll(data, weights);
-  const Image& g1 = filtered.filtered[0];
-  const Image& g2 = filtered.filtered[1];
+  const std::vector<Image> filtered =
+      featureNlMeans(data, &patch, {}, {.r = params.r, .minCenterWeight = 1e-3f});
+  const Image& g1 = filtered[0];
+  const Image& g2 = filtered[1];
 
   feature.value = Image(f1.width(), f1.height(), channels);
   for (size_t k = 0; k < g1.size(); ++k)

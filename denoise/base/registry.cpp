@@ -5,6 +5,7 @@
 #include "denoise/base/atrous.h"
 #include "denoise/base/bilateral.h"
 #include "denoise/base/dual_buffer_nlm.h"
+#include "denoise/base/joint_nlmeans.h"
 #include "denoise/base/nfor.h"
 #include "denoise/base/rdfc.h"
 #include "denoise/base/sbf.h"
@@ -38,6 +39,12 @@ const std::vector<DenoiserEntry>& builtinDenoisers() {
        "SURE-selected NL-means candidates with feature prefiltering and a second pass "
        "(Rousselle et al. 2013)",
        [](ParamMap& p) { return std::make_unique<Rdfc>(RdfcParams::fromParams(p)); }},
+      {"jnlm",
+       "joint NL-means: colour patches with variance cancellation plus albedo/normal/depth range "
+       "terms, cross-filtered halves when present",
+       [](ParamMap& p) {
+         return std::make_unique<JointNlMeans>(JointNlMeansParams::fromParams(p));
+       }},
   };
   return entries;
 }

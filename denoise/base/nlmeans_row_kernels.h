@@ -1,15 +1,15 @@
 #pragma once
-// The inner loops of RDFC's candidate filters (rdfc_candidates.cpp): one call processes one row
-// segment of n pixels for one window offset δ. Every loop is branch-free over contiguous arrays
-// so that it vectorises; validity (neighbours outside the image) comes in as 0/1 masks. The
-// kernels are compiled for AVX2 and for the baseline architecture (the loader picks one);
-// neither uses FMA, so both give bit-identical results.
+// The inner loops of the NL-means filters with feature terms (feature_nlmeans.cpp,
+// rdfc_candidates.cpp): one call processes one row segment of n pixels for one window offset δ.
+// Every loop is branch-free over contiguous arrays so that it vectorises; validity (neighbours
+// outside the image) comes in as 0/1 masks. The kernels are compiled for AVX2 and for the baseline
+// architecture (the loader picks one); neither uses FMA, so both give bit-identical results.
 //
 // Conventions: `p` arrays hold the centre pixels' values, `q` / `qp` / `qm` the values at p + δ /
 // p + δ / p − δ (pointers into zero-padded planes). "num" variances are α V, "den" variances
 // k² Vn, as in nlmeans_weights.h.
 
-namespace chorus::rdfc {
+namespace chorus::rows {
 
 // out += min(clamp, [(f − fq)² − (vn + min(vn, vnq))] / (den + denq + ε)) for two denominator
 // sets (A, B): one feature channel's pixel distance to p + δ.
@@ -28,13 +28,34 @@ void addSymmetricDistance(int n, const float* f, const float* fp, const float* f
 void minTermWeights(int n, float scale, const float* dPlus, const float* dMinus, const float* dSym,
                     const float* symMask, float minRefineWeight, float* outPlus, float* outMinus);
 
-// One colour channel's pixel distances (shares 1/3 of the channel average, clamped) to p + δ,
-// p − δ and to their mean, added to plus / minus / sym. With slope outputs (non-null), also
-// their derivatives with respect to g(p) (unclamped), written to sPlus / sMinus / sSym.
+// One channel's share (channelShare = 1 / channels of the channel average, clamped) of the
+// patch-term pixel distances to p + δ, p − δ and to their mean, added to plus / minus / sym;
+// the symmetric denominator is vd + neighbourShare (vdp + vdm) (0.25; with vdp = vdm = vd and
+// 0.5, the centre-only 2 vd). With slope outputs (non-null), also their derivatives with respect
+// to g(p) (unclamped), written to sPlus / sMinus / sSym.
 void addColorDistances(int n, const float* g, const float* gp, const float* gm, const float* vn,
                        const float* vnp, const float* vnm, const float* vd, const float* vdp,
-                       const float* vdm, float* plus, float* minus, float* sym, float* sPlus,
-                       float* sMinus, float* sSym);
+                       const float* vdm, float channelShare, float neighbourShare, float* plus,
+                       float* minus, float* sym, float* sPlus, float* sMinus, float* sSym);
+
+// One feature channel's pixel distances (clamped) to p + δ, p − δ and to their mean, added to
+// plus / minus / sym, with one denominator set (symmetric: den + neighbourShare (denp + denm)).
+// sym may be null (no symmetric distance).
+void addFeatureDistances(int n, const float* f, const float* fp, const float* fm, const float* vn,
+                         const float* vnp, const float* vnm, const float* den, const float* denp,
+                         const float* denm, float neighbourShare, float* plus, float* minus,
+                         float* sym);
+
+// dst = max(dst, scale · src).
+void maxScaled(int n, float scale, const float* src, float* dst);
+
+// w = mask · exp(−max(0, d)).
+void maskedWeights(int n, const float* d, const float* mask, float* w);
+
+// Refined weights exp(−max(0, d)) of a patch term for δ and −δ (0 where the mask is 0).
+void patchWeights(int n, const float* dPlus, const float* dMinus, const float* dSym,
+                  const float* maskPlus, const float* maskMinus, const float* maskSym,
+                  float minRefineWeight, float* wPlus, float* wMinus);
 
 // Derivatives (shares 1/3) with respect to g(p) of the pixel distances in which p is a
 // *neighbour* within its own patch sums: pair (p − δ, p) → nearPlus; pair (p + δ, p) → nearMinus;
@@ -109,4 +130,4 @@ void accumulateWeightSums(int n, const float* wPlus, const float* wMinus, float*
 void accumulateData(int n, const float* wPlus, const float* wMinus, const float* up,
                     const float* um, float* acc);
 
-}  // namespace chorus::rdfc
+}  // namespace chorus::rows

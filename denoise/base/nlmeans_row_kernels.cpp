@@ -1,4 +1,4 @@
-#include "denoise/base/rdfc_row_kernels.h"
+#include "denoise/base/nlmeans_row_kernels.h"
 
 // Floating-point operations never trap here (no FP exceptions are enabled in chorus), which lets
 // GCC turn the selects of these loops (clamps, refinement) into vector blends. It changes no
@@ -16,13 +16,12 @@
 #define RDFC_KERNEL
 #endif
 
-namespace chorus::rdfc {
+namespace chorus::rows {
 namespace {
 
 constexpr float kEpsilon = 1e-10f;
 constexpr float kClamp = 1e4f;  // NlMeansTerm's default distance clamp
 constexpr float kThird = 1.0f / 3.0f;
-constexpr float kThirdClamp = kClamp * kThird;  // a channel's clamped share
 
 inline float clampDistance(float d) {
   return d <= kClamp ? d : kClamp;
@@ -91,31 +90,84 @@ void addColorDistances(int n, const float* __restrict g, const float* __restrict
                        const float* __restrict gm, const float* __restrict vn,
                        const float* __restrict vnp, const float* __restrict vnm,
                        const float* __restrict vd, const float* __restrict vdp,
-                       const float* __restrict vdm, float* __restrict plus, float* __restrict minus,
-                       float* __restrict sym, float* __restrict sPlus, float* __restrict sMinus,
-                       float* __restrict sSym) {
+                       const float* __restrict vdm, float channelShare, float neighbourShare,
+                       float* __restrict plus, float* __restrict minus, float* __restrict sym,
+                       float* __restrict sPlus, float* __restrict sMinus, float* __restrict sSym) {
+  const float clamp = kClamp * channelShare;
   for (int i = 0; i < n; ++i) {
     const float mp = std::min(vn[i], vnp[i]), mm = std::min(vn[i], vnm[i]);
     const float diffP = g[i] - gp[i], diffM = g[i] - gm[i];
     const float diffS = g[i] - 0.5f * (gp[i] + gm[i]);
     const float invP = 1.0f / (vd[i] + vdp[i] + kEpsilon);
     const float invM = 1.0f / (vd[i] + vdm[i] + kEpsilon);
-    const float invS = 1.0f / (vd[i] + 0.25f * (vdp[i] + vdm[i]) + kEpsilon);
-    const float dp = kThird * ((diffP * diffP - (vn[i] + mp)) * invP);
-    const float dm = kThird * ((diffM * diffM - (vn[i] + mm)) * invM);
-    const float ds = kThird * ((diffS * diffS - (vn[i] + 0.25f * (mp + mm))) * invS);
-    plus[i] += dp <= kThirdClamp ? dp : kThirdClamp;
-    minus[i] += dm <= kThirdClamp ? dm : kThirdClamp;
-    sym[i] += ds <= kThirdClamp ? ds : kThirdClamp;
+    const float invS = 1.0f / (vd[i] + neighbourShare * (vdp[i] + vdm[i]) + kEpsilon);
+    const float dp = channelShare * ((diffP * diffP - (vn[i] + mp)) * invP);
+    const float dm = channelShare * ((diffM * diffM - (vn[i] + mm)) * invM);
+    const float ds = channelShare * ((diffS * diffS - (vn[i] + 0.25f * (mp + mm))) * invS);
+    plus[i] += dp <= clamp ? dp : clamp;
+    minus[i] += dm <= clamp ? dm : clamp;
+    sym[i] += ds <= clamp ? ds : clamp;
   }
   if (!sPlus) return;
   for (int i = 0; i < n; ++i) {
     // d/dg(p) of diff² · inv = 2 diff · inv
     const float diffP = g[i] - gp[i], diffM = g[i] - gm[i];
     const float diffS = g[i] - 0.5f * (gp[i] + gm[i]);
-    sPlus[i] = 2.0f * kThird * diffP / (vd[i] + vdp[i] + kEpsilon);
-    sMinus[i] = 2.0f * kThird * diffM / (vd[i] + vdm[i] + kEpsilon);
-    sSym[i] = 2.0f * kThird * diffS / (vd[i] + 0.25f * (vdp[i] + vdm[i]) + kEpsilon);
+    sPlus[i] = 2.0f * channelShare * diffP / (vd[i] + vdp[i] + kEpsilon);
+    sMinus[i] = 2.0f * channelShare * diffM / (vd[i] + vdm[i] + kEpsilon);
+    sSym[i] = 2.0f * channelShare * diffS / (vd[i] + neighbourShare * (vdp[i] + vdm[i]) + kEpsilon);
+  }
+}
+
+RDFC_KERNEL
+void addFeatureDistances(int n, const float* __restrict f, const float* __restrict fp,
+                         const float* __restrict fm, const float* __restrict vn,
+                         const float* __restrict vnp, const float* __restrict vnm,
+                         const float* __restrict den, const float* __restrict denp,
+                         const float* __restrict denm, float neighbourShare, float* __restrict plus,
+                         float* __restrict minus, float* __restrict sym) {
+  if (!sym) {
+    for (int i = 0; i < n; ++i) {
+      const float mp = std::min(vn[i], vnp[i]), mm = std::min(vn[i], vnm[i]);
+      const float diffP = f[i] - fp[i], diffM = f[i] - fm[i];
+      plus[i] += clampDistance((diffP * diffP - (vn[i] + mp)) / (den[i] + denp[i] + kEpsilon));
+      minus[i] += clampDistance((diffM * diffM - (vn[i] + mm)) / (den[i] + denm[i] + kEpsilon));
+    }
+    return;
+  }
+  for (int i = 0; i < n; ++i) {
+    const float mp = std::min(vn[i], vnp[i]), mm = std::min(vn[i], vnm[i]);
+    const float diffP = f[i] - fp[i], diffM = f[i] - fm[i];
+    const float diffS = f[i] - 0.5f * (fp[i] + fm[i]);
+    plus[i] += clampDistance((diffP * diffP - (vn[i] + mp)) / (den[i] + denp[i] + kEpsilon));
+    minus[i] += clampDistance((diffM * diffM - (vn[i] + mm)) / (den[i] + denm[i] + kEpsilon));
+    sym[i] += clampDistance((diffS * diffS - (vn[i] + 0.25f * (mp + mm))) /
+                            (den[i] + neighbourShare * (denp[i] + denm[i]) + kEpsilon));
+  }
+}
+
+RDFC_KERNEL
+void maxScaled(int n, float scale, const float* __restrict src, float* __restrict dst) {
+  for (int i = 0; i < n; ++i) dst[i] = std::max(dst[i], scale * src[i]);
+}
+
+RDFC_KERNEL
+void maskedWeights(int n, const float* __restrict d, const float* __restrict mask,
+                   float* __restrict w) {
+  for (int i = 0; i < n; ++i) w[i] = mask[i] * weightOf(d[i]);
+}
+
+RDFC_KERNEL
+void patchWeights(int n, const float* __restrict dPlus, const float* __restrict dMinus,
+                  const float* __restrict dSym, const float* __restrict maskPlus,
+                  const float* __restrict maskMinus, const float* __restrict maskSym,
+                  float minRefineWeight, float* __restrict wPlus, float* __restrict wMinus) {
+  for (int i = 0; i < n; ++i) {
+    const float w1 = maskPlus[i] * weightOf(dPlus[i]), w2 = maskMinus[i] * weightOf(dMinus[i]);
+    const float ws = weightOf(dSym[i]);
+    const float a = refineFactor(w1, w2, ws, maskSym[i], minRefineWeight);
+    wPlus[i] = a * ws + (1.0f - a) * w1;
+    wMinus[i] = a * ws + (1.0f - a) * w2;
   }
 }
 
@@ -225,4 +277,4 @@ void accumulateData(int n, const float* __restrict wPlus, const float* __restric
   for (int i = 0; i < n; ++i) acc[i] += wPlus[i] * up[i] + wMinus[i] * um[i];
 }
 
-}  // namespace chorus::rdfc
+}  // namespace chorus::rows

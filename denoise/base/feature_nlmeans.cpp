@@ -1,0 +1,386 @@
+#include "denoise/base/feature_nlmeans.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "denoise/base/filters/pixel_rect.h"
+#include "denoise/base/nlmeans_row_kernels.h"
+#include "denoise/base/padded_planes.h"
+#include "denoise/util/float_lanes.h"
+
+namespace chorus {
+namespace {
+
+constexpr int kTileWidth = 64, kTileHeight = 32;
+constexpr float kSymmetricLimit = 25.0f;  // refine only where both distances are below this
+enum Kind { kPlus, kMinus, kSym };
+
+// The pixels of kind (+: p + δ exists, −: p − δ, sym: both) form a rectangle of the image.
+struct ValidRects {
+  PixelRect rect[3];
+  ValidRects(int w, int h, int dx, int dy) {
+    rect[kPlus] = neighbourInside(w, h, dx, dy);
+    rect[kMinus] = neighbourInside(w, h, -dx, -dy);
+    rect[kSym] = rect[kPlus].intersect(rect[kMinus]);
+  }
+};
+
+// 1 inside `valid`, 0 elsewhere, over the rectangle `area` (row-major).
+void fillMask(const PixelRect& area, const PixelRect& valid, float* mask) {
+  const int w = area.width();
+  for (int y = area.y0; y < area.y1; ++y) {
+    float* row = mask + size_t(y - area.y0) * size_t(w);
+    std::fill(row, row + w, 0.0f);
+    if (y < valid.y0 || y >= valid.y1) continue;
+    const int a = std::clamp(valid.x0 - area.x0, 0, w), b = std::clamp(valid.x1 - area.x0, 0, w);
+    std::fill(row + a, row + std::max(a, b), 1.0f);
+  }
+}
+
+// dst (over `out`) = box mean of src (over `in`, which contains `out` grown by r) of radius r,
+// each sum divided by the number of pixels of `valid` in the box (src is 0 outside `valid`).
+void boxMean(const float* src, const PixelRect& in, float* dst, const PixelRect& out, int r,
+             const PixelRect& valid, std::vector<float>& rowSums) {
+  const int ow = out.width(), iw = in.width();
+  rowSums.resize(size_t(ow) * size_t(out.height() + 2 * r));
+  for (int y = out.y0 - r; y < out.y1 + r; ++y) {
+    const float* s = src + size_t(y - in.y0) * size_t(iw) + size_t(out.x0 - in.x0);
+    float* h = rowSums.data() + size_t(y - out.y0 + r) * size_t(ow);
+    for (int i = 0; i < ow; ++i) h[i] = s[i - r];
+    for (int j = -r + 1; j <= r; ++j)
+      for (int i = 0; i < ow; ++i) h[i] += s[i + j];
+  }
+  std::vector<float> invX(static_cast<size_t>(ow));
+  for (int i = 0; i < ow; ++i) {
+    const int n = boxOverlap(out.x0 + i, r, valid.x0, valid.x1);
+    invX[size_t(i)] = n > 0 ? 1.0f / float(n) : 0.0f;
+  }
+  for (int y = out.y0; y < out.y1; ++y) {
+    float* d = dst + size_t(y - out.y0) * size_t(ow);
+    const float* first = rowSums.data() + size_t(y - out.y0) * size_t(ow);
+    for (int i = 0; i < ow; ++i) d[i] = first[i];
+    for (int j = 1; j <= 2 * r; ++j) {
+      const float* h = rowSums.data() + size_t(y - out.y0 + j) * size_t(ow);
+      for (int i = 0; i < ow; ++i) d[i] += h[i];
+    }
+    const int ny = boxOverlap(y, r, valid.y0, valid.y1);
+    const float invY = ny > 0 ? 1.0f / float(ny) : 0.0f;
+    for (int i = 0; i < ow; ++i) d[i] *= invY * invX[size_t(i)];
+  }
+}
+
+struct TileMemory {
+  std::vector<float> mask[3], featPlus, featMinus, termRow[3];
+  std::vector<float> ext[3], dist[3], gridMask[3], gridPlus, gridMinus, rowSums;
+  std::vector<float> patchPlus, patchMinus, wPlus, wMinus;
+  std::vector<float> weightSum, maxWeight;
+  std::vector<float> acc;  // every data channel, one plane each
+};
+
+class FeatureNlMeansKernel {
+ public:
+  FeatureNlMeansKernel(std::span<const Image* const> data, const PatchTerm* patch,
+                       std::span<const FeatureTerm> features, const FeatureNlMeansParams& params);
+  std::vector<Image> run() const;
+
+ private:
+  void runTile(const PixelRect& tile, TileMemory& m, std::vector<Image>& out) const;
+  void featureWeights(const PixelRect& tile, int dx, int dy, TileMemory& m) const;
+  void unrefinedFeatureWeights(const PixelRect& tile, int dx, int dy, TileMemory& m) const;
+  void patchWeights(const PixelRect& tile, int dx, int dy, TileMemory& m) const;
+
+  int width_ = 0, height_ = 0, pad_ = 0, dataChannels_ = 0;
+  FeatureNlMeansParams params_;
+  float refineMinWeight_;
+  std::vector<int> dataBegin_;  // first plane of every data image in data_
+  PaddedPlanes data_;
+  // Patch term.
+  bool hasPatch_ = false;
+  int f_ = 0, box_ = 0, patchChannels_ = 0;
+  bool patchCentreOnly_ = false;
+  PaddedPlanes g_, vn_, vd_;
+  // Feature terms: one plane per channel of every term.
+  std::vector<int> termBegin_;
+  std::vector<bool> termCentreOnly_;
+  PaddedPlanes fValue_, fNum_, fDen_;
+};
+
+FeatureNlMeansKernel::FeatureNlMeansKernel(std::span<const Image* const> data,
+                                           const PatchTerm* patch,
+                                           std::span<const FeatureTerm> features,
+                                           const FeatureNlMeansParams& params)
+    : params_(params), refineMinWeight_(std::exp(-kSymmetricLimit)) {
+  if (data.empty()) throw std::invalid_argument("featureNlMeans: no data");
+  width_ = data[0]->width();
+  height_ = data[0]->height();
+  if (params.r < 0) throw std::invalid_argument("featureNlMeans: negative window radius");
+  auto requireSize = [&](const Image* image, const char* what) {
+    if (!image || image->width() != width_ || image->height() != height_)
+      throw std::invalid_argument(std::string("featureNlMeans: ") + what +
+                                  " missing or size differs");
+  };
+  for (const Image* d : data) requireSize(d, "data");
+  if (patch) {
+    requireSize(patch->guide, "guide");
+    requireSize(patch->variance, "guide variance");
+    if (!patch->guide->sameShape(*patch->variance) || patch->f < 0 || patch->weightBoxRadius < 0)
+      throw std::invalid_argument("featureNlMeans: bad patch term");
+    hasPatch_ = true;
+    f_ = patch->f;
+    box_ = patch->weightBoxRadius;
+    patchCentreOnly_ = patch->centerOnlyDenominator;
+    patchChannels_ = patch->guide->channels();
+  }
+  for (const FeatureTerm& t : features) {
+    requireSize(t.value, "feature");
+    requireSize(t.variance, "feature variance");
+    if (!t.value->sameShape(*t.variance) ||
+        (t.normalizingVariance && !t.value->sameShape(*t.normalizingVariance)))
+      throw std::invalid_argument("featureNlMeans: feature shapes differ");
+  }
+  pad_ = params.r + f_ + box_ + 1;
+
+  int planes = 0;
+  for (const Image* d : data) {
+    dataBegin_.push_back(planes);
+    planes += d->channels();
+  }
+  dataBegin_.push_back(planes);
+  dataChannels_ = planes;
+  data_ = PaddedPlanes(width_, height_, planes, pad_);
+  for (size_t i = 0; i < data.size(); ++i)
+    for (int c = 0; c < data[i]->channels(); ++c) data_.set(dataBegin_[i] + c, *data[i], c);
+
+  if (hasPatch_) {
+    g_ = vn_ = vd_ = PaddedPlanes(width_, height_, patchChannels_, pad_);
+    for (int c = 0; c < patchChannels_; ++c) {
+      g_.set(c, *patch->guide, c);
+      vn_.set(c, *patch->variance, c, patch->alpha);
+      vd_.set(c, *patch->variance, c, patch->k * patch->k);
+    }
+  }
+  int channels = 0;
+  for (const FeatureTerm& t : features) {
+    termBegin_.push_back(channels);
+    termCentreOnly_.push_back(t.centerOnlyDenominator);
+    channels += t.value->channels();
+  }
+  termBegin_.push_back(channels);
+  fValue_ = fNum_ = fDen_ = PaddedPlanes(width_, height_, channels, pad_);
+  for (size_t j = 0; j < features.size(); ++j) {
+    const FeatureTerm& t = features[j];
+    const Image& den = t.normalizingVariance ? *t.normalizingVariance : *t.variance;
+    for (int c = 0; c < t.value->channels(); ++c) {
+      const int k = termBegin_[j] + c;
+      fValue_.set(k, *t.value, c);
+      fNum_.set(k, *t.variance, c, t.alpha);
+      fDen_.set(k, den, c, t.k * t.k);
+    }
+  }
+}
+
+void FeatureNlMeansKernel::featureWeights(const PixelRect& tile, int dx, int dy,
+                                          TileMemory& m) const {
+  const int tw = tile.width(), x0 = tile.x0;
+  const size_t area = size_t(tile.area());
+  if (!params_.refineFeatures) {
+    unrefinedFeatureWeights(tile, dx, dy, m);
+    return;
+  }
+  std::fill(m.featPlus.begin(), m.featPlus.begin() + ptrdiff_t(area), 1.0f);
+  std::fill(m.featMinus.begin(), m.featMinus.begin() + ptrdiff_t(area), 1.0f);
+  for (int y = tile.y0; y < tile.y1; ++y) {
+    const size_t row = size_t(y - tile.y0) * size_t(tw);
+    for (size_t term = 0; term + 1 < termBegin_.size(); ++term) {
+      for (auto& r : m.termRow) std::fill(r.begin(), r.begin() + tw, 0.0f);
+      const bool centre = termCentreOnly_[term];
+      for (int k = termBegin_[term]; k < termBegin_[term + 1]; ++k) {
+        const float* den = fDen_.row(k, y) + x0;
+        rows::addFeatureDistances(
+            tw, fValue_.row(k, y) + x0, fValue_.row(k, y + dy) + x0 + dx,
+            fValue_.row(k, y - dy) + x0 - dx, fNum_.row(k, y) + x0, fNum_.row(k, y + dy) + x0 + dx,
+            fNum_.row(k, y - dy) + x0 - dx, den, centre ? den : fDen_.row(k, y + dy) + x0 + dx,
+            centre ? den : fDen_.row(k, y - dy) + x0 - dx, centre ? 0.5f : 0.25f,
+            m.termRow[kPlus].data(), m.termRow[kMinus].data(), m.termRow[kSym].data());
+      }
+      const float scale = 1.0f / float(termBegin_[term + 1] - termBegin_[term]);
+      rows::minTermWeights(tw, scale, m.termRow[kPlus].data(), m.termRow[kMinus].data(),
+                           m.termRow[kSym].data(), m.mask[kSym].data() + row, refineMinWeight_,
+                           m.featPlus.data() + row, m.featMinus.data() + row);
+    }
+  }
+  for (size_t i = 0; i < area; ++i) {
+    m.featPlus[i] *= m.mask[kPlus][i];
+    m.featMinus[i] *= m.mask[kMinus][i];
+  }
+}
+
+void FeatureNlMeansKernel::unrefinedFeatureWeights(const PixelRect& tile, int dx, int dy,
+                                                   TileMemory& m) const {
+  const int tw = tile.width(), x0 = tile.x0;
+  for (int y = tile.y0; y < tile.y1; ++y) {
+    const size_t row = size_t(y - tile.y0) * size_t(tw);
+    float* maxPlus = m.termRow[kSym].data();  // scratch: max over terms of D(p, p + δ)
+    float* maxMinus = m.featMinus.data() + row;
+    std::fill(maxPlus, maxPlus + tw, 0.0f);
+    std::fill(maxMinus, maxMinus + tw, 0.0f);
+    for (size_t term = 0; term + 1 < termBegin_.size(); ++term) {
+      std::fill(m.termRow[kPlus].begin(), m.termRow[kPlus].begin() + tw, 0.0f);
+      std::fill(m.termRow[kMinus].begin(), m.termRow[kMinus].begin() + tw, 0.0f);
+      const bool centre = termCentreOnly_[term];
+      for (int k = termBegin_[term]; k < termBegin_[term + 1]; ++k) {
+        const float* den = fDen_.row(k, y) + x0;
+        rows::addFeatureDistances(tw, fValue_.row(k, y) + x0, fValue_.row(k, y + dy) + x0 + dx,
+                                  fValue_.row(k, y - dy) + x0 - dx, fNum_.row(k, y) + x0,
+                                  fNum_.row(k, y + dy) + x0 + dx, fNum_.row(k, y - dy) + x0 - dx,
+                                  den, centre ? den : fDen_.row(k, y + dy) + x0 + dx,
+                                  centre ? den : fDen_.row(k, y - dy) + x0 - dx, 0.25f,
+                                  m.termRow[kPlus].data(), m.termRow[kMinus].data(), nullptr);
+      }
+      const float scale = 1.0f / float(termBegin_[term + 1] - termBegin_[term]);
+      rows::maxScaled(tw, scale, m.termRow[kPlus].data(), maxPlus);
+      rows::maxScaled(tw, scale, m.termRow[kMinus].data(), maxMinus);
+    }
+    rows::maskedWeights(tw, maxPlus, m.mask[kPlus].data() + row, m.featPlus.data() + row);
+    rows::maskedWeights(tw, maxMinus, m.mask[kMinus].data() + row, maxMinus);
+  }
+}
+
+void FeatureNlMeansKernel::patchWeights(const PixelRect& tile, int dx, int dy,
+                                        TileMemory& m) const {
+  const ValidRects valid(width_, height_, dx, dy);
+  const PixelRect grid = tile.grown(box_), ext = grid.grown(f_);
+  const int ew = ext.width(), gw = grid.width();
+  const size_t eArea = size_t(ext.area()), gArea = size_t(grid.area());
+  for (auto& e : m.ext) std::fill(e.begin(), e.begin() + ptrdiff_t(eArea), 0.0f);
+  const float share = 1.0f / float(patchChannels_);
+  const int ox = ext.x0;
+  for (int y = ext.y0; y < ext.y1; ++y) {
+    const size_t e = size_t(y - ext.y0) * size_t(ew);
+    for (int c = 0; c < patchChannels_; ++c) {
+      const float* vd = vd_.row(c, y) + ox;
+      rows::addColorDistances(
+          ew, g_.row(c, y) + ox, g_.row(c, y + dy) + ox + dx, g_.row(c, y - dy) + ox - dx,
+          vn_.row(c, y) + ox, vn_.row(c, y + dy) + ox + dx, vn_.row(c, y - dy) + ox - dx, vd,
+          patchCentreOnly_ ? vd : vd_.row(c, y + dy) + ox + dx,
+          patchCentreOnly_ ? vd : vd_.row(c, y - dy) + ox - dx, share,
+          patchCentreOnly_ ? 0.5f : 0.25f, m.ext[kPlus].data() + e, m.ext[kMinus].data() + e,
+          m.ext[kSym].data() + e, nullptr, nullptr, nullptr);
+    }
+  }
+  // Patch means over the grid (the tile grown by the weight box), counting valid pixels only.
+  for (int kind = 0; kind < 3; ++kind) {
+    fillMask(ext, valid.rect[kind], m.gridMask[kind].data());  // scratch: the ext mask
+    for (size_t i = 0; i < eArea; ++i) m.ext[kind][i] *= m.gridMask[kind][i];
+    boxMean(m.ext[kind].data(), ext, m.dist[kind].data(), grid, f_, valid.rect[kind], m.rowSums);
+    fillMask(grid, valid.rect[kind], m.gridMask[kind].data());
+  }
+  for (int y = grid.y0; y < grid.y1; ++y) {
+    const size_t r = size_t(y - grid.y0) * size_t(gw);
+    rows::patchWeights(gw, m.dist[kPlus].data() + r, m.dist[kMinus].data() + r,
+                       m.dist[kSym].data() + r, m.gridMask[kPlus].data() + r,
+                       m.gridMask[kMinus].data() + r, m.gridMask[kSym].data() + r, refineMinWeight_,
+                       m.gridPlus.data() + r, m.gridMinus.data() + r);
+  }
+  (void)gArea;
+  // "Patchwise": the weights themselves box-filtered over the valid pixels.
+  if (box_ > 0) {
+    boxMean(m.gridPlus.data(), grid, m.patchPlus.data(), tile, box_, valid.rect[kPlus], m.rowSums);
+    boxMean(m.gridMinus.data(), grid, m.patchMinus.data(), tile, box_, valid.rect[kMinus],
+            m.rowSums);
+  } else {
+    std::copy(m.gridPlus.begin(), m.gridPlus.begin() + ptrdiff_t(tile.area()), m.patchPlus.begin());
+    std::copy(m.gridMinus.begin(), m.gridMinus.begin() + ptrdiff_t(tile.area()),
+              m.patchMinus.begin());
+  }
+}
+
+void FeatureNlMeansKernel::runTile(const PixelRect& tile, TileMemory& m,
+                                   std::vector<Image>& out) const {
+  const FlushDenormals flush;  // tiny weights times data would be denormal
+  const size_t area = size_t(tile.area());
+  const int tw = tile.width(), x0 = tile.x0;
+  const size_t gridArea = size_t(kTileWidth + 2 * box_) * size_t(kTileHeight + 2 * box_);
+  const size_t extArea =
+      size_t(kTileWidth + 2 * (box_ + f_)) * size_t(kTileHeight + 2 * (box_ + f_));
+  for (auto& v : m.mask) v.resize(area);
+  for (auto& v : m.termRow) v.resize(kTileWidth);
+  for (auto& v : m.ext) v.resize(extArea);
+  for (auto& v : m.dist) v.resize(gridArea);
+  for (auto& v : m.gridMask) v.resize(extArea);
+  for (auto* v : {&m.featPlus, &m.featMinus, &m.patchPlus, &m.patchMinus, &m.wPlus, &m.wMinus})
+    v->resize(area);
+  m.gridPlus.resize(gridArea);
+  m.gridMinus.resize(gridArea);
+  m.weightSum.assign(area, 0.0f);
+  m.maxWeight.assign(area, 0.0f);
+  m.acc.assign(area * size_t(dataChannels_), 0.0f);
+
+  const int r = params_.r;
+  for (int dy = 0; dy <= r; ++dy)
+    for (int dx = dy == 0 ? 1 : -r; dx <= r; ++dx) {
+      const ValidRects valid(width_, height_, dx, dy);
+      for (int kind = 0; kind < 3; ++kind) fillMask(tile, valid.rect[kind], m.mask[kind].data());
+      featureWeights(tile, dx, dy, m);
+      const float* wPlus = m.featPlus.data();
+      const float* wMinus = m.featMinus.data();
+      if (hasPatch_) {
+        patchWeights(tile, dx, dy, m);
+        for (size_t i = 0; i < area; ++i) {
+          m.wPlus[i] = std::min(m.patchPlus[i], m.featPlus[i]);
+          m.wMinus[i] = std::min(m.patchMinus[i], m.featMinus[i]);
+        }
+        wPlus = m.wPlus.data();
+        wMinus = m.wMinus.data();
+      }
+      for (int y = tile.y0; y < tile.y1; ++y) {
+        const size_t row = size_t(y - tile.y0) * size_t(tw);
+        rows::accumulateWeightSums(tw, wPlus + row, wMinus + row, m.weightSum.data() + row,
+                                   m.maxWeight.data() + row);
+        for (int k = 0; k < dataChannels_; ++k)
+          rows::accumulateData(tw, wPlus + row, wMinus + row, data_.row(k, y + dy) + x0 + dx,
+                               data_.row(k, y - dy) + x0 - dx,
+                               m.acc.data() + size_t(k) * area + row);
+      }
+    }
+
+  for (int y = tile.y0; y < tile.y1; ++y)
+    for (int x = tile.x0; x < tile.x1; ++x) {
+      const size_t i = size_t(y - tile.y0) * size_t(tw) + size_t(x - x0);
+      const float centre = std::max(m.maxWeight[i], params_.minCenterWeight);
+      const float total = m.weightSum[i] + centre;
+      for (size_t d = 0; d + 1 < dataBegin_.size(); ++d)
+        for (int c = 0; c < dataBegin_[d + 1] - dataBegin_[d]; ++c) {
+          const int k = dataBegin_[d] + c;
+          out[d](x, y, c) = (m.acc[size_t(k) * area + i] + centre * data_.row(k, y)[x]) / total;
+        }
+    }
+}
+
+std::vector<Image> FeatureNlMeansKernel::run() const {
+  std::vector<Image> out;
+  for (size_t d = 0; d + 1 < dataBegin_.size(); ++d)
+    out.emplace_back(width_, height_, dataBegin_[d + 1] - dataBegin_[d]);
+  std::vector<PixelRect> tiles;
+  for (int y = 0; y < height_; y += kTileHeight)
+    for (int x = 0; x < width_; x += kTileWidth)
+      tiles.push_back({x, y, std::min(width_, x + kTileWidth), std::min(height_, y + kTileHeight)});
+  tbb::enumerable_thread_specific<TileMemory> memory;
+  tbb::parallel_for(size_t(0), tiles.size(),
+                    [&](size_t t) { runTile(tiles[t], memory.local(), out); });
+  return out;
+}
+
+}  // namespace
+
+std::vector<Image> featureNlMeans(std::span<const Image* const> data, const PatchTerm* patch,
+                                  std::span<const FeatureTerm> features,
+                                  const FeatureNlMeansParams& params) {
+  return FeatureNlMeansKernel(data, patch, features, params).run();
+}
+
+}  // namespace chorus

@@ -1,0 +1,46 @@
+#pragma once
+// Planar float images with a zero border, for the NL-means row kernels (nlmeans_row_kernels.h):
+// a kernel may read any neighbour within `pad` pixels of the image without bounds checks.
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+#include "denoise/image/image.h"
+
+namespace chorus {
+
+class PaddedPlanes {
+ public:
+  PaddedPlanes() = default;
+  PaddedPlanes(int width, int height, int channels, int pad)
+      : pad_(pad),
+        stride_(size_t(width + 2 * pad)),
+        planeSize_(stride_ * size_t(height + 2 * pad)),
+        data_(planeSize_ * size_t(channels), 0.0f) {}
+  // Channel c of this ← channel sourceChannel of image × scale.
+  void set(int c, const Image& image, int sourceChannel, float scale = 1.0f) {
+    for (int y = 0; y < image.height(); ++y) {
+      float* row = mutableRow(c, y);
+      for (int x = 0; x < image.width(); ++x) row[x] = scale * image(x, y, sourceChannel);
+    }
+  }
+  float* mutableRow(int c, int y) {
+    return data_.data() + size_t(c) * planeSize_ + size_t(y + pad_) * stride_ + size_t(pad_);
+  }
+  // Pointer to pixel (0, y) of channel c; valid for x, y within `pad` of the image.
+  const float* row(int c, int y) const {
+    return data_.data() + size_t(c) * planeSize_ + size_t(y + pad_) * stride_ + size_t(pad_);
+  }
+
+ private:
+  int pad_ = 0;
+  size_t stride_ = 0, planeSize_ = 0;
+  std::vector<float> data_;
+};
+
+// Offsets o ∈ [−r, r] along one axis with x + o in [lo, hi): a box's true pixel count.
+inline int boxOverlap(int x, int r, int lo, int hi) {
+  return std::max(0, std::min(x + r + 1, hi) - std::max(x - r, lo));
+}
+
+}  // namespace chorus

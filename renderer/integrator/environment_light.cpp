@@ -73,7 +73,7 @@ Rgb EnvironmentLight::texel(Vec2f uv) const {
   return Rgb((*map_)(x, y, 0), (*map_)(x, y, 1), (*map_)(x, y, 2)) * scale_;
 }
 
-Rgb EnvironmentLight::Le(Vec3f direction) const {
+Rgb EnvironmentLight::Le(const Vec3f& direction) const {
   if (!emits_) return Rgb(0.0f);
   if (kind_ == EnvironmentDesc::Kind::Constant) return constant_;
   return texel(directionToUv(toMap(direction)));
@@ -92,7 +92,7 @@ std::optional<EnvironmentLight::Sample> EnvironmentLight::sample(Vec2f u) const 
   return Sample{toWorld(dMap), texel(uv), pdfUv / (2.0f * kPi * kPi * sinTheta)};
 }
 
-float EnvironmentLight::pdfSolidAngle(Vec3f direction) const {
+float EnvironmentLight::pdfSolidAngle(const Vec3f& direction) const {
   if (!emits_) return 0.0f;
   if (kind_ == EnvironmentDesc::Kind::Constant) return kUniformSpherePdfSolidAngle;
   const Vec3f d = toMap(direction);

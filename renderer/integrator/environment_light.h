@@ -19,7 +19,7 @@ class EnvironmentLight {
   // Whether it emits at all (a black map or colour emits nothing and is never sampled).
   bool emits() const { return emits_; }
   // Radiance arriving from world direction `direction` (unit).
-  Rgb Le(Vec3f direction) const;
+  Rgb Le(const Vec3f& direction) const;
 
   struct Sample {
     Vec3f wi;  // unit, toward the environment
@@ -27,7 +27,7 @@ class EnvironmentLight {
     float pdfSolidAngle = 0;
   };
   std::optional<Sample> sample(Vec2f u) const;
-  float pdfSolidAngle(Vec3f direction) const;
+  float pdfSolidAngle(const Vec3f& direction) const;
 
   // Power estimate for choosing between lights: an emitter of the environment's mean radiance
   // on the scene's bounding sphere, 4π² r² L̄ (as pbrt-v4's infinite lights).

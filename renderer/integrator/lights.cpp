@@ -92,7 +92,7 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene), environment_(scene.envi
   choice_ = AliasTable(power);
 }
 
-std::optional<LightSample> LightSet::sample(Vec3f ref, float uChoice, Vec2f u) const {
+std::optional<LightSample> LightSet::sample(const Vec3f& ref, float uChoice, Vec2f u) const {
   if (lights_.empty()) return std::nullopt;
   float pmf = 0;
   const int index = choice_.sample(uChoice, &pmf);
@@ -121,7 +121,8 @@ std::optional<LightSample> LightSet::sample(Vec3f ref, float uChoice, Vec2f u) c
   return s;
 }
 
-std::optional<LightSample> LightSet::sampleArea(const AreaLight& light, Vec3f ref, Vec2f u) const {
+std::optional<LightSample> LightSet::sampleArea(const AreaLight& light, const Vec3f& ref,
+                                                Vec2f u) const {
   if (!(light.area > 0)) return std::nullopt;
   const Vec2f b = sampleUniformTriangle(u);
   const MeshDesc& mesh = scene_->data().meshes[light.geomID].mesh;
@@ -147,7 +148,7 @@ std::optional<LightSample> LightSet::sampleArea(const AreaLight& light, Vec3f re
 }
 
 std::optional<LightSample> LightSet::samplePunctual(const PunctualLightDesc& light,
-                                                    Vec3f ref) const {
+                                                    const Vec3f& ref) const {
   LightSample s;
   s.isDelta = true;
   s.pdf = 1.0f;
@@ -167,7 +168,7 @@ std::optional<LightSample> LightSet::samplePunctual(const PunctualLightDesc& lig
   return s;
 }
 
-float LightSet::pdfAreaLight(Vec3f ref, const SurfaceInteraction& lightPoint) const {
+float LightSet::pdfAreaLight(const Vec3f& ref, const SurfaceInteraction& lightPoint) const {
   if (lights_.empty()) return 0.0f;
   const SceneMesh& sm = scene_->data().meshes[lightPoint.geomID];
   if (sm.firstAreaLight < 0) return 0.0f;
@@ -181,7 +182,7 @@ float LightSet::pdfAreaLight(Vec3f ref, const SurfaceInteraction& lightPoint) co
   return choice_.pmf(int(index)) * distanceSquared / (cosLight * light.area);
 }
 
-float LightSet::pdfEnvironment(Vec3f direction) const {
+float LightSet::pdfEnvironment(const Vec3f& direction) const {
   if (environmentIndex_ < 0) return 0.0f;
   return choice_.pmf(environmentIndex_) * environment_.pdfSolidAngle(direction);
 }

@@ -31,13 +31,13 @@ class LightSet {
   bool empty() const { return lights_.empty(); }
 
   // Picks a light with uChoice and a point or direction on it with u.
-  std::optional<LightSample> sample(Vec3f refPosition, float uChoice, Vec2f u) const;
+  std::optional<LightSample> sample(const Vec3f& refPosition, float uChoice, Vec2f u) const;
 
   // The pdf sample() would have for reaching emissive triangle `lightPoint` from refPosition
   // (solid angle, including the choice probability): the MIS weight of a BSDF-sampled hit.
-  float pdfAreaLight(Vec3f refPosition, const SurfaceInteraction& lightPoint) const;
+  float pdfAreaLight(const Vec3f& refPosition, const SurfaceInteraction& lightPoint) const;
   // Likewise for a BSDF-sampled ray escaping in direction `direction` (unit).
-  float pdfEnvironment(Vec3f direction) const;
+  float pdfEnvironment(const Vec3f& direction) const;
 
   const EnvironmentLight& environment() const { return environment_; }
   size_t areaLightCount() const { return areaLights_.size(); }
@@ -53,8 +53,8 @@ class LightSet {
     float area;
   };
 
-  std::optional<LightSample> sampleArea(const AreaLight& light, Vec3f ref, Vec2f u) const;
-  std::optional<LightSample> samplePunctual(const PunctualLightDesc& light, Vec3f ref) const;
+  std::optional<LightSample> sampleArea(const AreaLight& light, const Vec3f& ref, Vec2f u) const;
+  std::optional<LightSample> samplePunctual(const PunctualLightDesc& light, const Vec3f& ref) const;
 
   const Scene* scene_;
   std::vector<AreaLight> areaLights_;  // index = SceneMesh::firstAreaLight + primID

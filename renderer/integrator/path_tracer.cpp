@@ -37,7 +37,7 @@ Rgb volumeTransmittance(const MaterialDesc& m, float distance) {
 
 }  // namespace
 
-bool PathTracer::unoccluded(const SurfaceInteraction& si, Vec3f ng,
+bool PathTracer::unoccluded(const SurfaceInteraction& si, const Vec3f& ng,
                             const LightSample& light) const {
   const Vec3f origin = offsetRayOrigin(si.position, si.positionError, ng, light.wi);
   if (light.isInfinite)

@@ -41,7 +41,7 @@ class PathTracer {
   PathSample trace(const Ray& cameraRay, Sampler& sampler, uint64_t& rays) const;
 
  private:
-  bool unoccluded(const SurfaceInteraction& si, Vec3f ng, const LightSample& light) const;
+  bool unoccluded(const SurfaceInteraction& si, const Vec3f& ng, const LightSample& light) const;
 
   const Scene& scene_;
   const LightSet& lights_;

@@ -99,20 +99,24 @@ bool materialNeedsAlphaTest(const MaterialDesc& m, const std::vector<TextureDesc
 }
 
 // The unit geometric normal of a triangle, turned to the side its vertex normals face (the
-// authored normals define the outside; the winding may disagree).
-Vec3f orientedGeometricNormal(const MeshDesc& mesh, const uint32_t* idx, Vec3f p0, Vec3f p1,
-                              Vec3f p2, float b0, float b1, float b2, Vec3f* interpolatedNormal) {
-  Vec3f ng = cross(p1 - p0, p2 - p0);
+// authored normals define the outside; the winding may disagree). *shadingNormal receives the
+// interpolated vertex normal (the geometric normal without usable vertex normals). Positions are
+// read here rather than passed as Vec3f arguments: 12-byte structs passed by value cost
+// store-forwarding stalls on x86-64.
+inline Vec3f orientedGeometricNormal(const MeshDesc& mesh, const uint32_t* idx, float b0, float b1,
+                                     float b2, Vec3f* shadingNormal) {
+  const Vec3f& p0 = mesh.positions[idx[0]];
+  Vec3f ng = cross(mesh.positions[idx[1]] - p0, mesh.positions[idx[2]] - p0);
   const float ngLength = length(ng);
   ng = ngLength > 0 ? ng / ngLength : Vec3f{0, 0, 1};
-  *interpolatedNormal = ng;
+  *shadingNormal = ng;
   if (!mesh.normals.empty()) {
     const Vec3f n =
         mesh.normals[idx[0]] * b0 + mesh.normals[idx[1]] * b1 + mesh.normals[idx[2]] * b2;
     const float len = length(n);
     if (len > 1e-6f && std::isfinite(len)) {
-      *interpolatedNormal = n / len;
-      if (dot(*interpolatedNormal, ng) < 0) ng = -ng;
+      *shadingNormal = n / len;
+      if (dot(*shadingNormal, ng) < 0) ng = -ng;
     }
   }
   return ng;
@@ -229,7 +233,7 @@ bool Scene::intersect(const Ray& ray, Hit* hit, bool coherent) const {
   return true;
 }
 
-bool Scene::occluded(Vec3f origin, Vec3f direction, float tMax) const {
+bool Scene::occluded(const Vec3f& origin, const Vec3f& direction, float tMax) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay ray;
@@ -249,7 +253,7 @@ bool Scene::occluded(Vec3f origin, Vec3f direction, float tMax) const {
   return ray.tfar < 0;  // Embree sets tfar to −∞ on a hit
 }
 
-SurfaceInteraction Scene::interaction(const Hit& hit, Vec3f rayDirection) const {
+SurfaceInteraction Scene::interaction(const Hit& hit, const Vec3f& rayDirection) const {
   const SceneMesh& sm = data_->meshes[hit.geomID];
   const MeshDesc& mesh = sm.mesh;
   const uint32_t* idx = &mesh.indices[3 * size_t(hit.primID)];
@@ -265,7 +269,7 @@ SurfaceInteraction Scene::interaction(const Hit& hit, Vec3f rayDirection) const 
   si.uv = mesh.uvs.empty() ? Vec2f{0, 0}
                            : mesh.uvs[idx[0]] * b0 + mesh.uvs[idx[1]] * b1 + mesh.uvs[idx[2]] * b2;
   Vec3f ns;
-  const Vec3f ng = orientedGeometricNormal(mesh, idx, p0, p1, p2, b0, b1, b2, &ns);
+  const Vec3f ng = orientedGeometricNormal(mesh, idx, b0, b1, b2, &ns);
 
   const MaterialDesc& material = data_->materials[size_t(mesh.material)].desc;
   Vec3f tangent;
@@ -304,7 +308,7 @@ MaterialPoint Scene::materialPoint(const SurfaceInteraction& si) const {
 }
 
 Scene::EmitterPoint Scene::emitterPoint(uint32_t geomID, uint32_t primID, float b1, float b2,
-                                        Vec3f direction) const {
+                                        const Vec3f& direction) const {
   const MeshDesc& mesh = data_->meshes[geomID].mesh;
   const uint32_t* idx = &mesh.indices[3 * size_t(primID)];
   const float b0 = 1 - b1 - b2;
@@ -313,7 +317,7 @@ Scene::EmitterPoint Scene::emitterPoint(uint32_t geomID, uint32_t primID, float 
   e.position = p0 * b0 + p1 * b1 + p2 * b2;
   e.positionError = barycentricPositionError(p0, p1, p2, b0, b1, b2);
   Vec3f ns;
-  e.geometricNormal = orientedGeometricNormal(mesh, idx, p0, p1, p2, b0, b1, b2, &ns);
+  e.geometricNormal = orientedGeometricNormal(mesh, idx, b0, b1, b2, &ns);
   const MaterialDesc& m = data_->materials[size_t(mesh.material)].desc;
   const bool front = dot(direction, e.geometricNormal) < 0;
   if (m.isEmissive() && (front || m.doubleSided)) {

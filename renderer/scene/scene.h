@@ -77,9 +77,9 @@ class Scene {
   // Closest hit along the ray within (0, ray.tMax], or false.
   bool intersect(const Ray& ray, Hit* hit, bool coherent = false) const;
   // Whether anything blocks the segment (0, tMax) along direction.
-  bool occluded(Vec3f origin, Vec3f direction, float tMax) const;
+  bool occluded(const Vec3f& origin, const Vec3f& direction, float tMax) const;
 
-  SurfaceInteraction interaction(const Hit& hit, Vec3f rayDirection) const;
+  SurfaceInteraction interaction(const Hit& hit, const Vec3f& rayDirection) const;
   MaterialPoint materialPoint(const SurfaceInteraction& si) const;
   // Radiance emitted toward −rayDirection (zero behind single-sided emitters).
   Rgb emitted(const SurfaceInteraction& si) const;
@@ -92,7 +92,7 @@ class Scene {
     Rgb Le;
   };
   EmitterPoint emitterPoint(uint32_t geomID, uint32_t primID, float b1, float b2,
-                            Vec3f direction) const;
+                            const Vec3f& direction) const;
 
   const SceneData& data() const { return *data_; }
   const Material& material(int index) const { return data_->materials[size_t(index)]; }

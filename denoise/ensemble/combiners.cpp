@@ -1,0 +1,314 @@
+#include "denoise/ensemble/combiners.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "denoise/ensemble/blend.h"
+#include "denoise/ensemble/pairwise_solver.h"
+#include "denoise/util/error.h"
+
+namespace chorus {
+namespace {
+
+constexpr Combiner kAllCombiners[] = {Combiner::Ensemble,  Combiner::Average,
+                                      Combiner::OnehotPre, Combiner::OnehotPost,
+                                      Combiner::Oracle,    Combiner::OracleUnconstrained};
+
+class StageClock {
+ public:
+  explicit StageClock(std::vector<StageTime>& times) : times_(times) {}
+  void stop(const std::string& stage) {
+    const auto now = std::chrono::steady_clock::now();
+    times_.push_back({stage, std::chrono::duration<double>(now - start_).count()});
+    start_ = now;
+  }
+
+ private:
+  std::vector<StageTime>& times_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+std::vector<Image> zeroMaps(int n, int width, int height, int channels) {
+  return std::vector<Image>(size_t(n), Image(width, height, channels));
+}
+
+struct SolvedWeights {
+  std::vector<Image> weights;
+  std::vector<BaseMask> valid;
+};
+
+// Rows per task of the solve: ⟨M⟩ is computed band by band (bounded memory, the window's halo
+// rows recomputed per band); results do not depend on the band height.
+constexpr int kBandRows = 16;
+
+// Per-pixel weights from ⟨M⟩ (or the oracle's true matrix).
+SolvedWeights solveWeights(const MseEstimator& estimator, SolverKind solver,
+                           const SimplexQpOptions& qp, uint64_t seed) {
+  const int n = estimator.baseCount(), groups = estimator.groups();
+  const int w = estimator.width(), h = estimator.height();
+  SolvedWeights solved{zeroMaps(n, w, h, groups), std::vector<BaseMask>(size_t(w) * size_t(h))};
+  const int bands = (h + kBandRows - 1) / kBandRows;
+  tbb::parallel_for(0, bands, [&](int band) {
+    const MseRows rows = estimator.rows(band * kBandRows, (band + 1) * kBandRows);
+    PixelMse pixel;
+    for (int y = rows.y0(); y < rows.y1(); ++y)
+      for (int x = 0; x < w; ++x) {
+        rows.pixel(x, y, pixel);
+        const size_t p = size_t(y) * size_t(w) + size_t(x);
+        solved.valid[p] = pixel.valid;
+        for (int g = 0; g < groups; ++g) {
+          const WeightVector weights =
+              solver == SolverKind::ActiveSet
+                  ? solveSimplexQp(pixel.h[size_t(g)], pixel.valid, qp).weights
+                  : solvePairwise(pixel.h[size_t(g)], seed, p * size_t(groups) + size_t(g),
+                                  pixel.valid)
+                        .weights;
+          for (int i = 0; i < n; ++i) solved.weights[size_t(i)](x, y, g) = float(weights[i]);
+        }
+      }
+  });
+  return solved;
+}
+
+// Per-base estimated MSE maps (the diagonal of H; the common constant does not change which
+// base is least), divided by their mean so that float storage works for any magnitude.
+// Invalid bases get 1e30 so they are not chosen (finite, so that filtering them is safe).
+struct DiagonalMaps {
+  std::vector<Image> maps;
+  std::vector<BaseMask> valid;
+};
+DiagonalMaps diagonalMaps(const MseEstimator& estimator) {
+  const int n = estimator.baseCount(), groups = estimator.groups();
+  const int w = estimator.width(), h = estimator.height();
+  const size_t pixels = size_t(w) * size_t(h);
+  std::vector<double> values(pixels * size_t(groups) * size_t(n));
+  DiagonalMaps out{zeroMaps(n, w, h, groups), std::vector<BaseMask>(pixels)};
+  const int bands = (h + kBandRows - 1) / kBandRows;
+  tbb::parallel_for(0, bands, [&](int band) {
+    const MseRows rows = estimator.rows(band * kBandRows, (band + 1) * kBandRows);
+    for (int y = rows.y0(); y < rows.y1(); ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t p = size_t(y) * size_t(w) + size_t(x);
+        out.valid[p] = rows.valid(x, y);
+        for (int g = 0; g < groups; ++g)
+          for (int i = 0; i < n; ++i)
+            values[(p * size_t(groups) + size_t(g)) * size_t(n) + size_t(i)] =
+                rows.diagonal(x, y, g, i);
+      }
+  });
+  double sum = 0;
+  size_t count = 0;
+  for (double v : values)
+    if (std::isfinite(v)) sum += std::abs(v), ++count;
+  double scale = count > 0 ? sum / double(count) : 1.0;
+  if (!(scale > 0.0) || !std::isfinite(scale)) scale = 1.0;
+  for (size_t p = 0; p < pixels; ++p)
+    for (int g = 0; g < groups; ++g)
+      for (int i = 0; i < n; ++i) {
+        const double v = values[(p * size_t(groups) + size_t(g)) * size_t(n) + size_t(i)] / scale;
+        const bool usable = ((out.valid[p] >> i) & 1u) && std::isfinite(v);
+        out.maps[size_t(i)].data()[p * size_t(groups) + size_t(g)] =
+            usable ? float(std::min(v, 1e30)) : 1e30f;
+      }
+  return out;
+}
+
+// One-hot weights: per pixel and group, 1 for the valid base with the least value.
+std::vector<Image> argminOneHot(const std::vector<Image>& maps,
+                                const std::vector<BaseMask>& valid) {
+  const int n = int(maps.size()), groups = maps[0].channels();
+  std::vector<Image> out = zeroMaps(n, maps[0].width(), maps[0].height(), groups);
+  for (size_t p = 0; p < valid.size(); ++p)
+    for (int g = 0; g < groups; ++g) {
+      const size_t e = p * size_t(groups) + size_t(g);
+      int best = -1;
+      for (int i = 0; i < n; ++i) {
+        if (!((valid[p] >> i) & 1u)) continue;
+        if (best < 0 || maps[size_t(i)].data()[e] < maps[size_t(best)].data()[e]) best = i;
+      }
+      if (best < 0)
+        for (int i = 0; i < n; ++i) out[size_t(i)].data()[e] = 1.0f / float(n);
+      else
+        out[size_t(best)].data()[e] = 1.0f;
+    }
+  return out;
+}
+
+std::vector<const Image*> outputsOf(std::span<const BaseOutputs* const> bases, BufferPart part) {
+  std::vector<const Image*> images;
+  for (const BaseOutputs* base : bases)
+    images.push_back(part == BufferPart::HalfA   ? &base->a
+                     : part == BufferPart::HalfB ? &base->b
+                                                 : &base->full);
+  return images;
+}
+
+struct Blends {
+  Image full, a, b;
+};
+Blends blendAll(const std::vector<Image>& weights, std::span<const BaseOutputs* const> bases,
+                const EnsembleGuides& guides) {
+  return {blend(weights, outputsOf(bases, BufferPart::Full), guides.color),
+          blend(weights, outputsOf(bases, BufferPart::HalfA), guides.colorA),
+          blend(weights, outputsOf(bases, BufferPart::HalfB), guides.colorB)};
+}
+
+// Weight filter step shared by the combiners: guided by the blend of `weights`.
+std::vector<Image> filterWeights(const std::vector<Image>& weights,
+                                 const std::vector<BaseMask>& valid,
+                                 std::span<const BaseOutputs* const> bases,
+                                 const EnsembleGuides& guides, const WeightFilterOptions& options,
+                                 bool nonNegative) {
+  const Blends raw = blendAll(weights, bases, guides);
+  const ColorGuide guide = makeColorGuide(raw.full, raw.a, raw.b, options);
+  const std::vector<Image> filtered =
+      crossBilateralFilter(weights, guide, guides.normal, guides.albedo, options);
+  return renormalizeWeights(filtered, valid, weights, nonNegative);
+}
+
+}  // namespace
+
+std::string_view combinerName(Combiner combiner) {
+  switch (combiner) {
+    case Combiner::Ensemble:
+      return "ensemble";
+    case Combiner::Average:
+      return "average";
+    case Combiner::OnehotPre:
+      return "onehot-pre";
+    case Combiner::OnehotPost:
+      return "onehot-post";
+    case Combiner::Oracle:
+      return "oracle";
+    case Combiner::OracleUnconstrained:
+      return "oracle-unconstrained";
+  }
+  return "?";
+}
+
+Combiner parseCombiner(const std::string& name) {
+  std::string known;
+  for (Combiner c : kAllCombiners) {
+    if (combinerName(c) == name) return c;
+    known += (known.empty() ? "" : ", ") + std::string(combinerName(c));
+  }
+  throw Error("unknown combiner '" + name + "' (known: " + known + ")");
+}
+
+bool needsReference(Combiner combiner) {
+  return combiner == Combiner::Oracle || combiner == Combiner::OracleUnconstrained;
+}
+
+std::string_view solverName(SolverKind solver) {
+  return solver == SolverKind::ActiveSet ? "active-set" : "pairwise";
+}
+
+SolverKind parseSolver(const std::string& name) {
+  if (name == "active-set") return SolverKind::ActiveSet;
+  if (name == "pairwise") return SolverKind::Pairwise;
+  throw Error("unknown solver '" + name + "' (known: active-set, pairwise)");
+}
+
+CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,
+                      const CombineOptions& options, const Image* reference) {
+  checkEnsembleInputs(guides, bases);
+  if (needsReference(options.combiner) && !reference)
+    throw Error("the " + std::string(combinerName(options.combiner)) +
+                " combiner needs a reference image");
+  const int n = int(bases.size()), w = guides.width(), h = guides.height();
+  CombineResult result;
+  StageClock clock(result.times);
+
+  std::vector<BaseMask> valid;
+  bool nonNegative = true, filter = options.filter.enabled;
+  // onehot-pre filters the MSE maps, not the weights, and times its own stages.
+  const bool filtersBeforeChoosing = options.combiner == Combiner::OnehotPre;
+  switch (options.combiner) {
+    case Combiner::Ensemble: {
+      const MseEstimator estimator(guides, bases, options.mse);
+      SolvedWeights solved = solveWeights(estimator, options.solver, options.qp, options.seed);
+      result.rawWeights = std::move(solved.weights);
+      valid = std::move(solved.valid);
+      break;
+    }
+    case Combiner::Oracle:
+    case Combiner::OracleUnconstrained: {
+      const MseEstimator estimator = MseEstimator::oracle(guides, bases, *reference, options.mse);
+      SimplexQpOptions qp = options.qp;
+      nonNegative = qp.nonNegative = options.combiner == Combiner::Oracle;
+      SolvedWeights solved = solveWeights(estimator, SolverKind::ActiveSet, qp, options.seed);
+      result.rawWeights = std::move(solved.weights);
+      valid = std::move(solved.valid);
+      filter = false;
+      break;
+    }
+    case Combiner::Average: {
+      const MseEstimator estimator(guides, bases, options.mse);
+      result.rawWeights = zeroMaps(n, w, h, estimator.groups());
+      valid.resize(size_t(w) * size_t(h));
+      for (size_t p = 0; p < valid.size(); ++p) {
+        valid[p] = estimator.validAt(p);
+        const int count = std::popcount(valid[p]);
+        for (int i = 0; i < n; ++i)
+          for (int g = 0; g < estimator.groups(); ++g)
+            result.rawWeights[size_t(i)].data()[p * size_t(estimator.groups()) + size_t(g)] =
+                count == 0               ? 1.0f / float(n)
+                : ((valid[p] >> i) & 1u) ? 1.0f / float(count)
+                                         : 0.0f;
+      }
+      filter = false;
+      break;
+    }
+    case Combiner::OnehotPre: {
+      const MseEstimator estimator(guides, bases, options.mse);
+      DiagonalMaps diagonal = diagonalMaps(estimator);
+      valid = std::move(diagonal.valid);
+      clock.stop("solve");
+      if (filter) {
+        // Guided by the average blend: the combiner has no weights before this step.
+        std::vector<Image> uniform = zeroMaps(n, w, h, 1);
+        for (Image& map : uniform) map.fill(1.0f / float(n));
+        const Blends average = blendAll(uniform, bases, guides);
+        diagonal.maps = crossBilateralFilter(
+            diagonal.maps, makeColorGuide(average.full, average.a, average.b, options.filter),
+            guides.normal, guides.albedo, options.filter);
+      }
+      result.rawWeights = argminOneHot(diagonal.maps, valid);
+      clock.stop("filter");
+      filter = false;
+      break;
+    }
+    case Combiner::OnehotPost: {
+      const MseEstimator estimator(guides, bases, options.mse);
+      DiagonalMaps diagonal = diagonalMaps(estimator);
+      valid = std::move(diagonal.valid);
+      result.rawWeights = argminOneHot(diagonal.maps, valid);
+      break;
+    }
+  }
+  if (!filtersBeforeChoosing) clock.stop("solve");
+
+  if (filter) {
+    result.weights =
+        filterWeights(result.rawWeights, valid, bases, guides, options.filter, nonNegative);
+    clock.stop("filter");
+  } else {
+    result.weights = result.rawWeights;
+    if (!filtersBeforeChoosing) clock.stop("filter");
+  }
+
+  Blends blends = blendAll(result.weights, bases, guides);
+  result.image = std::move(blends.full);
+  result.mseEstimate = estimatedBlendMse(blends.a, blends.b, guides.colorA, guides.colorB);
+  result.imageA = std::move(blends.a);
+  result.imageB = std::move(blends.b);
+  clock.stop("blend");
+  return result;
+}
+
+}  // namespace chorus

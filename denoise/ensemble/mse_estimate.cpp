@@ -1,0 +1,240 @@
+#include "denoise/ensemble/mse_estimate.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "denoise/metrics/metrics.h"
+#include "denoise/util/error.h"
+
+namespace chorus {
+namespace {
+
+bool finite3(const float* v) {
+  return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+}
+
+// Index of (i, j), i ≤ j, in the packed upper triangle of an n × n matrix.
+int packed(int i, int j, int n) {
+  return i * n - i * (i - 1) / 2 + (j - i);
+}
+
+std::vector<float> finitePlanes(const Image& image) {
+  const size_t pixels = image.pixelCount();
+  std::vector<float> planes(pixels * 3);
+  for (size_t p = 0; p < pixels; ++p)
+    for (int c = 0; c < 3; ++c) {
+      const float v = image.data()[p * 3 + size_t(c)];
+      planes[size_t(c) * pixels + p] = std::isfinite(v) ? v : 0.0f;
+    }
+  return planes;
+}
+
+}  // namespace
+
+void MseRows::pixel(int x, int y, PixelMse& out) const {
+  const int n = baseCount_;
+  const size_t pixels = size_t(y1_ - y0_) * size_t(width_);
+  const size_t p = index(x, y);
+  out.groups = groups_;
+  out.valid = valid_[p];
+  for (int g = 0; g < groups_; ++g) {
+    const float* plane = planes_.data() + size_t(g * (entries_ + 1)) * pixels + p;
+    MseMatrix& h = out.h[size_t(g)];
+    h.resize(n, n);
+    int e = 0;
+    for (int i = 0; i < n; ++i)
+      for (int j = i; j < n; ++j, ++e) h(i, j) = h(j, i) = plane[size_t(e) * pixels] * unit_;
+    out.constant[size_t(g)] = plane[size_t(entries_) * pixels] * unit_;
+  }
+}
+
+double MseRows::diagonal(int x, int y, int group, int base) const {
+  const size_t pixels = size_t(y1_ - y0_) * size_t(width_);
+  const size_t plane = size_t(group * (entries_ + 1) + packed(base, base, baseCount_));
+  return planes_[plane * pixels + index(x, y)] * unit_;
+}
+
+MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,
+                           const MseOptions& options)
+    : MseEstimator(guides, bases, options, nullptr) {}
+
+MseEstimator MseEstimator::oracle(const EnsembleGuides& guides,
+                                  std::span<const BaseOutputs* const> bases, const Image& reference,
+                                  const MseOptions& options) {
+  if (reference.width() != guides.width() || reference.height() != guides.height() ||
+      reference.channels() != 3)
+    throw Error("the reference is " + std::to_string(reference.width()) + "x" +
+                std::to_string(reference.height()) + "x" + std::to_string(reference.channels()) +
+                ", expected " + std::to_string(guides.width()) + "x" +
+                std::to_string(guides.height()) + "x3");
+  return MseEstimator(guides, bases, options, &reference);
+}
+
+MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,
+                           const MseOptions& options, const Image* reference)
+    : options_(options) {
+  checkEnsembleInputs(guides, bases);
+  if (options.windowRadius < 0) throw Error("the MSE window radius must be at least 0");
+  width_ = guides.width();
+  height_ = guides.height();
+  baseCount_ = int(bases.size());
+  for (int i = 0; i < baseCount_; ++i) {
+    outA_[size_t(i)] = bases[size_t(i)]->a.data();
+    outB_[size_t(i)] = bases[size_t(i)]->b.data();
+    outFull_[size_t(i)] = bases[size_t(i)]->full.data();
+  }
+  colorA_ = guides.colorA.data();
+  colorB_ = guides.colorB.data();
+  reference_ = reference ? reference->data() : nullptr;
+
+  // Normalise the absolute form by the mean |x|², so that float planes hold O(1) values for
+  // any magnitude (1e-30 … 1e30).
+  double sum = 0;
+  size_t count = 0;
+  for (const Image* image : reference ? std::vector<const Image*>{reference}
+                                      : std::vector<const Image*>{&guides.colorA, &guides.colorB})
+    for (float v : image->values())
+      if (std::isfinite(v)) sum += std::abs(double(v)), ++count;
+  scale_ = count > 0 ? sum / double(count) : 1.0;
+  if (!(scale_ > 0.0) || !std::isfinite(scale_ * scale_) || !std::isfinite(1.0 / (scale_ * scale_)))
+    scale_ = 1.0;
+
+  if (options.windowRadius > 0) {
+    const float sigmaSpatial =
+        options.windowSigmaSpatial > 0 ? options.windowSigmaSpatial : float(options.windowRadius);
+    windowKernel_.radius = options.windowRadius;
+    windowKernel_.kSpatial = 0.5f / (sigmaSpatial * sigmaSpatial);
+    windowKernel_.kNormal = 0.5f / (options.windowSigmaNormal * options.windowSigmaNormal);
+    windowKernel_.kAlbedo = 0.5f / (options.windowSigmaAlbedo * options.windowSigmaAlbedo);
+    windowGuides_.width = width_;
+    windowGuides_.height = height_;
+    windowGuides_.normal = finitePlanes(guides.normal);
+    windowGuides_.albedo = finitePlanes(guides.albedo);
+  }
+}
+
+BaseMask MseEstimator::validAt(size_t pixel) const {
+  BaseMask mask = 0;
+  const size_t e = pixel * 3;
+  for (int i = 0; i < baseCount_; ++i) {
+    const bool finite =
+        finite3(outFull_[size_t(i)] + e) &&
+        (reference_ || (finite3(outA_[size_t(i)] + e) && finite3(outB_[size_t(i)] + e)));
+    if (finite) mask |= BaseMask(1) << i;
+  }
+  return mask;
+}
+
+std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes) const {
+  const int n = baseCount_, entries = this->entries();
+  const size_t pixels = size_t(y1 - y0) * size_t(width_);
+  planes.assign(size_t(planeCount()) * pixels, 0.0f);
+  std::vector<char> complete(pixels, 0);
+  const BaseMask all = allBases(n);
+  std::array<double, 3 * ((kMaxDenoisers * (kMaxDenoisers + 1)) / 2 + 1)> acc{};
+  std::array<double, kMaxDenoisers> first{}, second{};
+  for (size_t local = 0; local < pixels; ++local) {
+    const size_t q = size_t(y0) * size_t(width_) + local;
+    const size_t e = q * 3;
+    if (reference_ ? !finite3(reference_ + e) : !(finite3(colorA_ + e) && finite3(colorB_ + e)))
+      continue;
+    const BaseMask valid = validAt(q);
+    std::fill(acc.begin(), acc.begin() + planeCount(), 0.0);
+    for (int c = 0; c < 3; ++c) {
+      const size_t ec = e + size_t(c);
+      double weight = 1.0 / (scale_ * scale_);
+      if (options_.relative) {
+        double mu = 0;
+        int count = 0;
+        if (reference_) {
+          mu = reference_[ec], count = 1;
+        } else {
+          for (int i = 0; i < n; ++i)
+            if ((valid >> i) & 1u) mu += outFull_[size_t(i)][ec], ++count;
+        }
+        mu = count > 0 ? mu / count : 0.0;
+        weight = 1.0 / (mu * mu + kRelMseEpsilon);
+      }
+      double* h =
+          acc.data() + size_t((options_.form == MseForm::PerChannel ? c : 0) * (entries + 1));
+      if (reference_) {
+        // The oracle: e = y − r, H += e eᵀ.
+        const double r = reference_[ec];
+        for (int i = 0; i < n; ++i)
+          first[size_t(i)] = ((valid >> i) & 1u) ? double(outFull_[size_t(i)][ec]) - r : 0.0;
+        for (int i = 0, k = 0; i < n; ++i)
+          for (int j = i; j < n; ++j, ++k) h[k] += weight * first[size_t(i)] * first[size_t(j)];
+        continue;
+      }
+      // e^A = y^A − x^B, e^B = y^B − x^A; H += ½(e^A e^Aᵀ + e^B e^Bᵀ), c += −½(x^A − x^B)².
+      const double xA = colorA_[ec], xB = colorB_[ec];
+      for (int i = 0; i < n; ++i) {
+        const bool on = (valid >> i) & 1u;
+        first[size_t(i)] = on ? double(outA_[size_t(i)][ec]) - xB : 0.0;
+        second[size_t(i)] = on ? double(outB_[size_t(i)][ec]) - xA : 0.0;
+      }
+      const double half = 0.5 * weight;
+      for (int i = 0, k = 0; i < n; ++i)
+        for (int j = i; j < n; ++j, ++k)
+          h[k] +=
+              half * (first[size_t(i)] * first[size_t(j)] + second[size_t(i)] * second[size_t(j)]);
+      h[entries] -= half * (xA - xB) * (xA - xB);
+    }
+    bool finite = true;
+    for (int k = 0; k < planeCount(); ++k) finite = finite && std::isfinite(float(acc[size_t(k)]));
+    if (!finite) continue;
+    for (int k = 0; k < planeCount(); ++k)
+      planes[size_t(k) * pixels + local] = float(acc[size_t(k)]);
+    complete[local] = valid == all;
+  }
+  return complete;
+}
+
+MseRows MseEstimator::rows(int y0, int y1) const {
+  y0 = std::clamp(y0, 0, height_);
+  y1 = std::clamp(y1, y0, height_);
+  MseRows out;
+  out.y0_ = y0;
+  out.y1_ = y1;
+  out.width_ = width_;
+  out.baseCount_ = baseCount_;
+  out.groups_ = groups();
+  out.entries_ = entries();
+  out.unit_ = options_.relative ? 1.0 : scale_ * scale_;
+  const size_t pixels = size_t(y1 - y0) * size_t(width_);
+  out.valid_.resize(pixels);
+  for (size_t local = 0; local < pixels; ++local)
+    out.valid_[local] = validAt(size_t(y0) * size_t(width_) + local);
+
+  const int r = options_.windowRadius;
+  if (r == 0) {
+    pixelTerms(y0, y1, out.planes_);
+    return out;
+  }
+  // Per-pixel terms of the rows the window reaches; pixels with a non-finite input are left
+  // out of every window; then the joint-bilateral window.
+  const int inY0 = std::max(0, y0 - r), inY1 = std::min(height_, y1 + r);
+  std::vector<float> in;
+  const std::vector<char> complete = pixelTerms(inY0, inY1, in);
+  const size_t inPixels = size_t(inY1 - inY0) * size_t(width_);
+  for (size_t local = 0; local < inPixels; ++local)
+    if (!complete[local])
+      for (int k = 0; k < planeCount(); ++k) in[size_t(k) * inPixels + local] = 0.0f;
+  out.planes_.assign(size_t(planeCount()) * pixels, 0.0f);
+  std::vector<const float*> inPlanes;
+  std::vector<float*> outPlanes;
+  for (int k = 0; k < planeCount(); ++k) {
+    inPlanes.push_back(in.data() + size_t(k) * inPixels);
+    outPlanes.push_back(out.planes_.data() + size_t(k) * pixels);
+  }
+  filterPlaneRows(windowGuides_, windowKernel_, inPlanes, inY0, y0, y1, outPlanes);
+  return out;
+}
+
+PixelMse MseEstimator::at(int x, int y) const {
+  PixelMse out;
+  rows(y, y + 1).pixel(x, y, out);
+  return out;
+}
+
+}  // namespace chorus

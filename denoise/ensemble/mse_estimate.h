@@ -1,0 +1,128 @@
+#pragma once
+// The dual-buffer estimate of the base outputs' error matrix (Zheng et al. 2021, §4). For one
+// pixel and colour channel, with noisy half means x^A, x^B and base outputs y_i^A, y_i^B:
+//
+//   ⟨M⟩^A = y^A y^Aᵀ − x^B (1 y^Aᵀ + y^A 1ᵀ) + x^A x^B 11ᵀ,   ⟨M⟩^B likewise (A ↔ B),
+//   ⟨M⟩   = ½(⟨M⟩^A + ⟨M⟩^B).
+//
+// Because x^B is independent of y^A and E[x^A x^B] = μ², ⟨M⟩^A is unbiased for
+// E[(y^A − μ)(y^A − μ)ᵀ], the half-buffer error matrix. Expanding,
+//
+//   ⟨M⟩ = H + c·11ᵀ,  H = ½(e^A e^Aᵀ + e^B e^Bᵀ),  e^A = y^A − x^B·1,  e^B = y^B − x^A·1,
+//   c = −½(x^A − x^B)²,
+//
+// a positive semi-definite H plus a multiple of 11ᵀ that is constant on the simplex. The
+// estimator returns H and c separately: the solver needs only H (better conditioned), the
+// estimated MSE of a blend w is wᵀHw + c.
+//
+// Options:
+// - form: one matrix per colour channel (as the reference code: one weight vector per channel)
+//   or the sum over the three channels (one weight vector per pixel).
+// - windowRadius: accumulate H and c over a (2r+1)² neighbourhood with joint-bilateral weights
+//   k(p,q) = exp(−|p−q|²/(2σ_s²) − |n_p−n_q|²/(2σ_n²) − |a_p−a_q|²/(2σ_a²)) from the normal
+//   and albedo (not the noisy colour, which would correlate the weights with the residuals).
+//   0 = per pixel, as in the paper. Accumulating keeps the estimate unbiased (up to the
+//   normalisation by Σk, which does not change the minimiser) and averages out the noise of
+//   x^A, x^B, which otherwise dominates the per-pixel choice (README: evidence).
+// - relative: divide each channel's terms by (μ̂² + ε), μ̂ = the mean of the finite bases'
+//   full-buffer outputs (the oracle: the reference), ε = 0.01, so that the objective targets
+//   relMSE instead of MSE.
+// Non-finite inputs: a base whose output (A, B or full) is NaN/Inf at a pixel is invalid there
+// (its bit in `valid` is 0; the solver gives it weight 0). A pixel where any base or x^A/x^B is
+// non-finite contributes nothing to its neighbours' windows.
+#include <array>
+#include <span>
+#include <vector>
+
+#include "denoise/ensemble/ensemble_inputs.h"
+#include "denoise/ensemble/ensemble_types.h"
+#include "denoise/ensemble/planar_filter.h"
+
+namespace chorus {
+
+enum class MseForm { PerChannel, Summed };
+
+struct MseOptions {
+  MseForm form = MseForm::Summed;
+  int windowRadius = 5;
+  bool relative = false;
+  float windowSigmaSpatial = 0;  // σ_s in pixels; 0 = the window radius
+  float windowSigmaNormal = 0.2f;
+  float windowSigmaAlbedo = 0.1f;
+};
+
+// ⟨M⟩ at one pixel in the objective's units (radiance², or relative), per channel group g
+// (3 groups, one per channel, or 1 summed): ⟨M⟩_g = h[g] + constant[g]·11ᵀ.
+struct PixelMse {
+  int groups = 0;
+  std::array<MseMatrix, 3> h;
+  std::array<double, 3> constant{};
+  BaseMask valid = 0;
+};
+
+// ⟨M⟩ for the rows [y0, y1) of the image, stored as float planes (normalised to O(1)).
+class MseRows {
+ public:
+  int y0() const { return y0_; }
+  int y1() const { return y1_; }
+  void pixel(int x, int y, PixelMse& out) const;
+  // Only the diagonal of h (the per-base estimated MSE), for the one-hot combiners.
+  double diagonal(int x, int y, int group, int base) const;
+  BaseMask valid(int x, int y) const { return valid_[index(x, y)]; }
+
+ private:
+  friend class MseEstimator;
+  size_t index(int x, int y) const { return size_t(y - y0_) * size_t(width_) + size_t(x); }
+  int y0_ = 0, y1_ = 0, width_ = 0, baseCount_ = 0, groups_ = 0, entries_ = 0;
+  double unit_ = 1.0;          // stored value × unit = objective units
+  std::vector<float> planes_;  // plane (g·(entries + 1) + e), e = packed upper triangle, then c
+  std::vector<BaseMask> valid_;
+};
+
+// Computes ⟨M⟩ for a fixed set of inputs. Holds pointers to the images it was built from (they
+// must outlive it); const and thread-safe after construction.
+class MseEstimator {
+ public:
+  // The dual-buffer estimate from the noisy halves (what the ensemble uses).
+  MseEstimator(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,
+               const MseOptions& options);
+  // The true error matrix of the full-buffer outputs against a reference (for the oracle):
+  // H = e eᵀ with e = y − r, c = 0.
+  static MseEstimator oracle(const EnsembleGuides& guides,
+                             std::span<const BaseOutputs* const> bases, const Image& reference,
+                             const MseOptions& options);
+
+  int baseCount() const { return baseCount_; }
+  int groups() const { return options_.form == MseForm::PerChannel ? 3 : 1; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const MseOptions& options() const { return options_; }
+
+  // ⟨M⟩ for rows [y0, y1) (reads rows y0 − r … y1 + r − 1 of the inputs).
+  MseRows rows(int y0, int y1) const;
+  // One pixel (computes its row; for tests and tools, not for loops over the image).
+  PixelMse at(int x, int y) const;
+  // The bases whose outputs are finite at a pixel (index y·width + x).
+  BaseMask validAt(size_t pixel) const;
+
+ private:
+  MseEstimator(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,
+               const MseOptions& options, const Image* reference);
+  // Per-pixel (unwindowed) planes for rows [y0, y1); returns per pixel whether every base and
+  // the noisy halves were finite (only such pixels may enter a neighbour's window).
+  std::vector<char> pixelTerms(int y0, int y1, std::vector<float>& planes) const;
+  int planeCount() const { return groups() * (entries() + 1); }
+  int entries() const { return baseCount_ * (baseCount_ + 1) / 2; }
+
+  MseOptions options_;
+  int width_ = 0, height_ = 0, baseCount_ = 0;
+  double scale_ = 1.0;  // absolute form: values are divided by scale² (scale = mean |x|)
+  std::array<const float*, kMaxDenoisers> outA_{}, outB_{}, outFull_{};
+  const float* colorA_ = nullptr;
+  const float* colorB_ = nullptr;
+  const float* reference_ = nullptr;  // oracle only
+  PlanarGuides windowGuides_;
+  BilateralKernel windowKernel_;
+};
+
+}  // namespace chorus

@@ -1,0 +1,178 @@
+#include "denoise/ensemble/weight_filter.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "denoise/ensemble/planar_filter.h"
+#include "denoise/util/error.h"
+
+namespace chorus {
+namespace {
+
+// Planar copy of an interleaved image: plane c holds channel c, row-major.
+std::vector<float> toPlanes(const Image& image) {
+  const size_t pixels = image.pixelCount();
+  const int channels = image.channels();
+  std::vector<float> planes(pixels * size_t(channels));
+  const float* src = image.data();
+  for (size_t p = 0; p < pixels; ++p)
+    for (int c = 0; c < channels; ++c) {
+      const float v = src[p * size_t(channels) + size_t(c)];
+      planes[size_t(c) * pixels + p] = std::isfinite(v) ? v : 0.0f;
+    }
+  return planes;
+}
+
+// Separable Gaussian blur with clipped, renormalised borders (double accumulation).
+Image gaussianBlur(const Image& image, int radius, float sigma) {
+  const int w = image.width(), h = image.height(), channels = image.channels();
+  std::vector<double> taps(size_t(2 * radius + 1));
+  for (int d = -radius; d <= radius; ++d)
+    taps[size_t(d + radius)] = std::exp(-0.5 * d * d / (double(sigma) * sigma));
+  Image horizontal(w, h, channels), out(w, h, channels);
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < channels; ++c) {
+        double sum = 0, weight = 0;
+        for (int d = std::max(-radius, -x); d <= std::min(radius, w - 1 - x); ++d) {
+          sum += taps[size_t(d + radius)] * image(x + d, y, c);
+          weight += taps[size_t(d + radius)];
+        }
+        horizontal(x, y, c) = float(sum / weight);
+      }
+  });
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < channels; ++c) {
+        double sum = 0, weight = 0;
+        for (int d = std::max(-radius, -y); d <= std::min(radius, h - 1 - y); ++d) {
+          sum += taps[size_t(d + radius)] * horizontal(x, y + d, c);
+          weight += taps[size_t(d + radius)];
+        }
+        out(x, y, c) = float(sum / weight);
+      }
+  });
+  return out;
+}
+
+}  // namespace
+
+ColorGuide makeColorGuide(const Image& blend, const Image& blendA, const Image& blendB,
+                          const WeightFilterOptions& options) {
+  if (!blend.sameShape(blendA) || !blend.sameShape(blendB))
+    throw Error("makeColorGuide: the blends differ in shape");
+  double sum = 0;
+  size_t count = 0;
+  for (float v : blend.values())
+    if (std::isfinite(v)) sum += std::abs(double(v)), ++count;
+  double scale = count > 0 ? sum / double(count) : 1.0;
+  if (!(scale > 0.0) || !std::isfinite(scale)) scale = 1.0;
+
+  ColorGuide guide;
+  guide.color = Image(blend.width(), blend.height(), blend.channels());
+  Image halfVariance(blend.width(), blend.height(), blend.channels());
+  for (size_t e = 0; e < blend.size(); ++e) {
+    const double z = blend.data()[e] / scale;
+    guide.color.data()[e] = std::isfinite(z) ? float(std::clamp(z, -1e6, 1e6)) : 0.0f;
+    const double d = (double(blendA.data()[e]) - blendB.data()[e]) / scale;
+    const double v = 0.5 * d * d;
+    halfVariance.data()[e] = std::isfinite(v) ? float(std::min(v, 1e12)) : 1e12f;
+  }
+  guide.variance =
+      gaussianBlur(halfVariance, options.varianceBlurRadius, options.varianceBlurSigma);
+  return guide;
+}
+
+std::vector<Image> crossBilateralFilter(std::span<const Image> maps, const ColorGuide& guide,
+                                        const Image& normal, const Image& albedo,
+                                        const WeightFilterOptions& options) {
+  if (maps.empty()) return {};
+  const int w = maps[0].width(), h = maps[0].height();
+  for (const Image* image : {&guide.color, &guide.variance, &normal, &albedo})
+    if (image->width() != w || image->height() != h || image->channels() != 3)
+      throw Error("crossBilateralFilter: guides must be RGB of the maps' size");
+  const size_t pixels = size_t(w) * size_t(h);
+
+  PlanarGuides guides;
+  guides.width = w;
+  guides.height = h;
+  guides.normal = toPlanes(normal);
+  guides.albedo = toPlanes(albedo);
+  guides.color = toPlanes(guide.color);
+  guides.variance = toPlanes(guide.variance);
+  BilateralKernel kernel;
+  kernel.radius = std::max(0, options.radius);
+  kernel.kSpatial = 0.5f / (options.sigmaSpatial * options.sigmaSpatial);
+  kernel.kColor = 0.5f / (options.sigmaColor * options.sigmaColor);
+  kernel.kNormal = 0.5f / (options.sigmaNormal * options.sigmaNormal);
+  kernel.kAlbedo = 0.5f / (options.sigmaAlbedo * options.sigmaAlbedo);
+
+  std::vector<std::vector<float>> inPlanes, outPlanes;
+  for (const Image& map : maps) {
+    if (map.width() != w || map.height() != h)
+      throw Error("crossBilateralFilter: maps differ in size");
+    const std::vector<float> planes = toPlanes(map);
+    for (int c = 0; c < map.channels(); ++c) {
+      inPlanes.emplace_back(planes.begin() + std::ptrdiff_t(size_t(c) * pixels),
+                            planes.begin() + std::ptrdiff_t(size_t(c + 1) * pixels));
+      outPlanes.emplace_back(pixels);
+    }
+  }
+  std::vector<const float*> in;
+  std::vector<float*> out;
+  for (size_t j = 0; j < inPlanes.size(); ++j) {
+    in.push_back(inPlanes[j].data());
+    out.push_back(outPlanes[j].data());
+  }
+  constexpr int kRowsPerTask = 16;
+  tbb::parallel_for(0, (h + kRowsPerTask - 1) / kRowsPerTask, [&](int task) {
+    const int y0 = task * kRowsPerTask, y1 = std::min(h, y0 + kRowsPerTask);
+    std::vector<float*> rowsOut;
+    for (float* plane : out) rowsOut.push_back(plane + size_t(y0) * size_t(w));
+    filterPlaneRows(guides, kernel, in, 0, y0, y1, rowsOut);
+  });
+
+  std::vector<Image> result;
+  size_t j = 0;
+  for (const Image& map : maps) {
+    const int channels = map.channels();
+    Image image(w, h, channels);
+    for (int c = 0; c < channels; ++c, ++j)
+      for (size_t p = 0; p < pixels; ++p)
+        image.data()[p * size_t(channels) + size_t(c)] = outPlanes[j][p];
+    result.push_back(std::move(image));
+  }
+  return result;
+}
+
+std::vector<Image> renormalizeWeights(std::span<const Image> weights,
+                                      std::span<const BaseMask> valid,
+                                      std::span<const Image> fallback, bool nonNegative) {
+  std::vector<Image> out(weights.begin(), weights.end());
+  if (weights.empty()) return out;
+  const int n = int(weights.size());
+  const int channels = weights[0].channels();
+  const size_t pixels = weights[0].pixelCount();
+  tbb::parallel_for(size_t(0), pixels, [&](size_t p) {
+    for (int c = 0; c < channels; ++c) {
+      const size_t e = p * size_t(channels) + size_t(c);
+      double sum = 0.0;
+      for (int i = 0; i < n; ++i) {
+        float& v = out[size_t(i)].data()[e];
+        if (!((valid[p] >> i) & 1u) || !std::isfinite(v)) v = 0.0f;
+        if (nonNegative && v < 0.0f) v = 0.0f;
+        sum += v;
+      }
+      const bool usable = std::isfinite(sum) && (nonNegative ? sum > 0.0 : std::abs(sum) > 1e-6);
+      for (int i = 0; i < n; ++i) {
+        float& v = out[size_t(i)].data()[e];
+        v = usable ? float(v / sum) : fallback[size_t(i)].data()[e];
+      }
+    }
+  });
+  return out;
+}
+
+}  // namespace chorus

@@ -1,0 +1,323 @@
+// The combination step end to end on synthetic renders with a known truth: the ensemble beats
+// the best single base output on the documented cases, is consistent, survives extreme and
+// non-finite inputs, and every combiner does what it says.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "denoise/ensemble/combiners.h"
+#include "denoise/ensemble/ensemble.h"
+#include "denoise/ensemble/synthetic_cases.h"
+#include "denoise/metrics/metrics.h"
+#include "denoise/util/error.h"
+
+namespace chorus {
+namespace {
+
+constexpr Combiner kCombiners[] = {Combiner::Ensemble,  Combiner::Average,
+                                   Combiner::OnehotPre, Combiner::OnehotPost,
+                                   Combiner::Oracle,    Combiner::OracleUnconstrained};
+
+void expectWeightsOnSimplex(const CombineResult& r, bool nonNegative = true) {
+  ASSERT_FALSE(r.weights.empty());
+  const size_t count = r.weights[0].size();
+  for (size_t e = 0; e < count; ++e) {
+    double sum = 0;
+    for (const Image& w : r.weights) {
+      const float v = w.data()[e];
+      ASSERT_TRUE(std::isfinite(v)) << "element " << e;
+      if (nonNegative) {
+        ASSERT_GE(v, 0.0f) << "element " << e;
+      }
+      sum += v;
+    }
+    ASSERT_NEAR(sum, 1.0, 1e-5) << "element " << e;
+  }
+}
+
+void expectFinite(const Image& image) {
+  for (float v : image.values()) ASSERT_TRUE(std::isfinite(v));
+}
+
+TEST(EnsembleCombiners, BeatsTheBestBaseOnTheDocumentedSyntheticCases) {
+  const std::vector<synthetic::Case> cases = synthetic::standardCases();
+  int wins = 0;
+  for (const synthetic::Case& c : cases) {
+    const synthetic::PreparedCase prepared = synthetic::prepareCase(c, 64, 64);
+    double best = std::numeric_limits<double>::infinity();
+    for (const BaseOutputs& base : prepared.bases)
+      best = std::min(best, relMse(base.full, prepared.truth));
+    const CombineResult result = combine(prepared.guides, pointersTo(prepared.bases), {});
+    expectWeightsOnSimplex(result);
+    const double ensemble = relMse(result.image, prepared.truth);
+    wins += ensemble < best;
+    std::printf("%-28s best base %.5f ensemble %.5f%s\n", c.name.c_str(), best, ensemble,
+                ensemble < best ? "" : "  (lost)");
+  }
+  EXPECT_GE(wins * 10, int(cases.size()) * 9) << wins << " wins of " << cases.size();
+}
+
+TEST(EnsembleCombiners, ConsistentWhenOneBaseIsExact) {
+  // One member returns the truth, the others are biased blurs: as the noise goes to 0 the
+  // blend's error goes to 0 (quadratically in the noise level), although every other member
+  // keeps its bias.
+  const synthetic::Scene scene = synthetic::makeScene(synthetic::SceneKind::Shadows, 40, 32);
+  std::vector<double> errors;
+  for (float noise : {0.3f, 0.03f, 0.003f, 0.0003f}) {
+    const synthetic::NoiseModel model{noise, 4, 0.0f};
+    const SampleBuffers buffers = synthetic::renderBuffers(scene, model, 4, 5);
+    const EnsembleSources sources = sourcesFromBuffers(buffers);
+    std::vector<EnsembleMember> members;
+    members.push_back({"exact", std::shared_ptr<const BaseDenoiser>(
+                                    synthetic::createConstantDenoiser("exact", scene.truth))});
+    for (const char* name : {"gauss3", "biased", "box1"})
+      members.push_back(
+          {name, std::shared_ptr<const BaseDenoiser>(synthetic::createSyntheticDenoiser(name))});
+    const std::vector<BaseOutputs> bases = runBaseDenoisers(sources, members);
+    const CombineResult result = combine(guidesFromSources(sources), pointersTo(bases), {});
+    errors.push_back(relMse(result.image, scene.truth));
+    EXPECT_GT(relMse(bases[1].full, scene.truth), 1e-3);  // the others stay wrong
+  }
+  for (size_t k = 1; k < errors.size(); ++k) EXPECT_LT(errors[k], errors[k - 1] * 0.1) << k;
+  EXPECT_LT(errors.back(), 1e-7);
+}
+
+// A small prepared case for the robustness tests.
+synthetic::PreparedCase smallCase(uint64_t seed = 3) {
+  synthetic::Case c = synthetic::standardCases()[0];
+  c.members = {"box1", "gauss3", "nlm", "biased"};
+  c.seed = seed;
+  return synthetic::prepareCase(c, 24, 20);
+}
+
+void scaleAll(synthetic::PreparedCase& p, float factor, int channel = -1) {
+  std::vector<Image*> images = {&p.guides.color, &p.guides.colorA, &p.guides.colorB, &p.truth};
+  for (BaseOutputs& b : p.bases) images.insert(images.end(), {&b.a, &b.b, &b.full});
+  for (Image* image : images)
+    for (size_t e = 0; e < image->size(); ++e)
+      if (channel < 0 || int(e % 3) == channel) image->data()[e] *= factor;
+}
+
+CombineOptions optionsFor(Combiner combiner, SolverKind solver = SolverKind::ActiveSet) {
+  CombineOptions o;
+  o.combiner = combiner;
+  o.solver = solver;
+  return o;
+}
+
+TEST(EnsembleCombiners, ExtremeMagnitudes) {
+  const synthetic::PreparedCase reference = smallCase();
+  const CombineResult unscaled =
+      combine(reference.guides, pointersTo(reference.bases), {}, &reference.truth);
+  for (float factor : {1e-30f, 1e30f}) {
+    synthetic::PreparedCase p = reference;
+    scaleAll(p, factor);
+    for (Combiner combiner : kCombiners)
+      for (SolverKind solver : {SolverKind::ActiveSet, SolverKind::Pairwise}) {
+        const CombineResult r =
+            combine(p.guides, pointersTo(p.bases), optionsFor(combiner, solver), &p.truth);
+        expectWeightsOnSimplex(r, combiner != Combiner::OracleUnconstrained);
+        expectFinite(r.image);
+        expectFinite(r.mseEstimate);
+      }
+    // The default path does not depend on the unit of radiance.
+    const CombineResult r = combine(p.guides, pointersTo(p.bases), {}, &p.truth);
+    for (size_t i = 0; i < r.weights.size(); ++i)
+      for (size_t e = 0; e < r.weights[i].size(); ++e)
+        ASSERT_NEAR(r.weights[i].data()[e], unscaled.weights[i].data()[e], 1e-3)
+            << "factor " << factor;
+  }
+  // One channel a million times brighter than the others.
+  synthetic::PreparedCase p = reference;
+  scaleAll(p, 1e6f, 1);
+  for (Combiner combiner : kCombiners) {
+    const CombineResult r = combine(p.guides, pointersTo(p.bases), optionsFor(combiner), &p.truth);
+    expectWeightsOnSimplex(r, combiner != Combiner::OracleUnconstrained);
+    expectFinite(r.image);
+  }
+}
+
+TEST(EnsembleCombiners, ZerosEverywhere) {
+  synthetic::PreparedCase p = smallCase();
+  scaleAll(p, 0.0f);
+  for (Combiner combiner : kCombiners) {
+    const CombineResult r = combine(p.guides, pointersTo(p.bases), optionsFor(combiner), &p.truth);
+    expectWeightsOnSimplex(r, combiner != Combiner::OracleUnconstrained);
+    for (float v : r.image.values()) ASSERT_EQ(v, 0.0f);
+  }
+}
+
+TEST(EnsembleCombiners, FireflyIsNotBlendedIn) {
+  // A 1e8 firefly in the noisy half A at one pixel, smeared by the box filter's A output.
+  synthetic::PreparedCase p = smallCase();
+  const int x = 12, y = 9;
+  for (int c = 0; c < 3; ++c) p.guides.colorA(x, y, c) = 1e8f;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int c = 0; c < 3; ++c) p.bases[0].a(x + dx, y + dy, c) += 1e8f / 9;
+  for (Combiner combiner : kCombiners) {
+    const CombineResult r = combine(p.guides, pointersTo(p.bases), optionsFor(combiner), &p.truth);
+    expectWeightsOnSimplex(r, combiner != Combiner::OracleUnconstrained);
+    expectFinite(r.image);
+    expectFinite(r.mseEstimate);
+  }
+  // The full-buffer outputs are clean, so the result stays clean.
+  const CombineResult r = combine(p.guides, pointersTo(p.bases), {});
+  for (int c = 0; c < 3; ++c) EXPECT_LT(std::abs(r.image(x, y, c) - p.truth(x, y, c)), 1.0f);
+}
+
+TEST(EnsembleCombiners, NonFiniteBaseOutputGetsZeroWeight) {
+  synthetic::PreparedCase p = smallCase();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  p.bases[2].full(5, 5, 0) = nan;
+  p.bases[2].a(6, 5, 1) = inf;
+  p.bases[2].b(7, 5, 2) = -inf;
+  for (int yy = 0; yy < 20; ++yy) p.bases[1].full(20, yy, 1) = nan;  // a whole column
+  for (Combiner combiner : kCombiners)
+    for (MseForm form : {MseForm::Summed, MseForm::PerChannel}) {
+      CombineOptions o = optionsFor(combiner);
+      o.mse.form = form;
+      const CombineResult r = combine(p.guides, pointersTo(p.bases), o, &p.truth);
+      expectWeightsOnSimplex(r, combiner != Combiner::OracleUnconstrained);
+      expectFinite(r.image);
+      for (int c = 0; c < r.weights[2].channels(); ++c) {
+        EXPECT_EQ(r.weights[2](5, 5, c), 0.0f) << combinerName(combiner);
+        EXPECT_EQ(r.weights[1](20, 11, c), 0.0f) << combinerName(combiner);
+        // The oracles only use the full-buffer outputs.
+        if (needsReference(combiner)) continue;
+        EXPECT_EQ(r.weights[2](6, 5, c), 0.0f) << combinerName(combiner);
+        EXPECT_EQ(r.weights[2](7, 5, c), 0.0f) << combinerName(combiner);
+      }
+    }
+  // Every base non-finite at a pixel: the noisy colour is used.
+  for (BaseOutputs& b : p.bases) b.full(3, 3, 0) = nan;
+  const CombineResult r = combine(p.guides, pointersTo(p.bases), {});
+  EXPECT_EQ(r.image(3, 3, 0), p.guides.color(3, 3, 0));
+}
+
+TEST(EnsembleCombiners, SameResultForAnyThreadCount) {
+  const synthetic::PreparedCase p = smallCase();
+  for (SolverKind solver : {SolverKind::ActiveSet, SolverKind::Pairwise}) {
+    CombineResult one, two;
+    {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+      one = combine(p.guides, pointersTo(p.bases), optionsFor(Combiner::Ensemble, solver));
+    }
+    {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+      two = combine(p.guides, pointersTo(p.bases), optionsFor(Combiner::Ensemble, solver));
+    }
+    EXPECT_TRUE(std::equal(one.image.values().begin(), one.image.values().end(),
+                           two.image.values().begin()));
+    for (size_t i = 0; i < one.weights.size(); ++i)
+      EXPECT_TRUE(std::equal(one.weights[i].values().begin(), one.weights[i].values().end(),
+                             two.weights[i].values().begin()));
+  }
+}
+
+TEST(EnsembleCombiners, AverageIsTheMeanOfTheOutputs) {
+  const synthetic::PreparedCase p = smallCase();
+  const CombineResult r = combine(p.guides, pointersTo(p.bases), optionsFor(Combiner::Average));
+  for (size_t e = 0; e < r.image.size(); ++e) {
+    double mean = 0;
+    for (const BaseOutputs& b : p.bases) mean += b.full.data()[e];
+    ASSERT_NEAR(r.image.data()[e], mean / p.bases.size(), 1e-5);
+  }
+}
+
+TEST(EnsembleCombiners, OraclePerPixelIsTheProjectionOfTheTruth) {
+  // Per channel, per pixel, no filter: the best convex blend of values y_i is the truth clamped
+  // to [min y_i, max y_i]; affine blends reach the truth itself.
+  const synthetic::PreparedCase p = smallCase();
+  CombineOptions o = optionsFor(Combiner::Oracle);
+  o.mse.form = MseForm::PerChannel;
+  o.mse.windowRadius = 0;
+  const CombineResult constrained = combine(p.guides, pointersTo(p.bases), o, &p.truth);
+  o.combiner = Combiner::OracleUnconstrained;
+  const CombineResult unconstrained = combine(p.guides, pointersTo(p.bases), o, &p.truth);
+  for (size_t e = 0; e < p.truth.size(); ++e) {
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (const BaseOutputs& b : p.bases) {
+      lo = std::min(lo, b.full.data()[e]);
+      hi = std::max(hi, b.full.data()[e]);
+    }
+    const float r = p.truth.data()[e];
+    ASSERT_NEAR(constrained.image.data()[e], std::clamp(r, lo, hi), 1e-4 * (1 + std::abs(r)));
+    if (hi - lo > 1e-3f) {
+      ASSERT_NEAR(unconstrained.image.data()[e], r, 1e-3 * (1 + std::abs(r)));
+    }
+  }
+}
+
+TEST(EnsembleCombiners, OneHotPicksTheLeastEstimatedError) {
+  const synthetic::PreparedCase p = smallCase();
+  CombineOptions o = optionsFor(Combiner::OnehotPost);
+  o.filter.enabled = false;
+  o.mse.windowRadius = 0;
+  o.mse.form = MseForm::PerChannel;
+  const CombineResult r = combine(p.guides, pointersTo(p.bases), o);
+  const MseEstimator estimator(p.guides, pointersTo(p.bases), o.mse);
+  for (int y = 0; y < 20; y += 3)
+    for (int x = 0; x < 24; x += 5) {
+      const PixelMse m = estimator.at(x, y);
+      for (int c = 0; c < 3; ++c) {
+        int best = 0;
+        for (int i = 1; i < int(p.bases.size()); ++i)
+          if (m.h[size_t(c)](i, i) < m.h[size_t(c)](best, best)) best = i;
+        EXPECT_EQ(r.weights[size_t(best)](x, y, c), 1.0f);
+        EXPECT_EQ(r.image(x, y, c), p.bases[size_t(best)].full(x, y, c));
+      }
+    }
+  // With the filter the pre/post variants blend, still on the simplex.
+  for (Combiner combiner : {Combiner::OnehotPre, Combiner::OnehotPost})
+    expectWeightsOnSimplex(combine(p.guides, pointersTo(p.bases), optionsFor(combiner)));
+}
+
+TEST(EnsembleCombiners, EstimatedMseMatchesTheDefinition) {
+  // ½[(z^A − x^B)² + (z^B − x^A)²] − ½(x^A − x^B)² from the A/B blends.
+  const synthetic::PreparedCase p = smallCase();
+  const CombineResult r = combine(p.guides, pointersTo(p.bases), {});
+  for (size_t e = 0; e < r.image.size(); e += 7) {
+    const double zA = r.imageA.data()[e], zB = r.imageB.data()[e];
+    const double xA = p.guides.colorA.data()[e], xB = p.guides.colorB.data()[e];
+    EXPECT_NEAR(r.mseEstimate.data()[e],
+                0.5 * ((zA - xB) * (zA - xB) + (zB - xA) * (zB - xA) - (xA - xB) * (xA - xB)),
+                1e-5 * (1 + xA * xA + xB * xB));
+  }
+  // Averaged over the image it tracks the true error of the half blends.
+  double estimated = 0, actual = 0;
+  for (size_t e = 0; e < r.image.size(); ++e) {
+    estimated += r.mseEstimate.data()[e];
+    const double t = p.truth.data()[e];
+    actual += 0.5 * (std::pow(r.imageA.data()[e] - t, 2) + std::pow(r.imageB.data()[e] - t, 2));
+  }
+  EXPECT_NEAR(estimated, actual, 0.5 * actual);
+}
+
+TEST(EnsembleCombiners, RejectsInconsistentInputs) {
+  synthetic::PreparedCase p = smallCase();
+  EXPECT_THROW(combine(p.guides, pointersTo(p.bases), optionsFor(Combiner::Oracle)), Error);
+  std::vector<BaseOutputs> duplicated = {p.bases[0], p.bases[0]};
+  EXPECT_THROW(combine(p.guides, pointersTo(duplicated), {}), Error);
+  std::vector<BaseOutputs> wrongSize = {p.bases[0]};
+  wrongSize[0].b = Image(5, 5, 3);
+  EXPECT_THROW(combine(p.guides, pointersTo(wrongSize), {}), Error);
+  std::vector<BaseOutputs> many;
+  for (int i = 0; i < kMaxDenoisers + 1; ++i) {
+    many.push_back(p.bases[0]);
+    many.back().name = "copy" + std::to_string(i);
+  }
+  EXPECT_THROW(combine(p.guides, pointersTo(many), {}), Error);
+  EXPECT_THROW(combine(p.guides, {}, {}), Error);
+  EXPECT_THROW(parseCombiner("best"), Error);
+  EXPECT_THROW(parseSolver("newton"), Error);
+  EXPECT_EQ(parseCombiner("onehot-pre"), Combiner::OnehotPre);
+}
+
+}  // namespace
+}  // namespace chorus

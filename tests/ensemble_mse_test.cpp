@@ -1,0 +1,320 @@
+// The dual-buffer MSE estimate: against a naive per-pixel implementation of its definition,
+// unbiased for the half-buffer error matrix (statistically, over many noise seeds, with a
+// leaky estimator as negative control), and robust to non-finite inputs and extreme scales.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "denoise/ensemble/mse_estimate.h"
+#include "denoise/metrics/metrics.h"
+#include "tests/support/test_support.h"
+
+namespace chorus {
+namespace {
+
+// Base-denoiser stand-ins, deterministic functions of the image they are given.
+Image boxBlur(const Image& in, int r) {
+  Image out(in.width(), in.height(), 3);
+  for (int y = 0; y < in.height(); ++y)
+    for (int x = 0; x < in.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0;
+        int count = 0;
+        for (int qy = std::max(0, y - r); qy <= std::min(in.height() - 1, y + r); ++qy)
+          for (int qx = std::max(0, x - r); qx <= std::min(in.width() - 1, x + r); ++qx, ++count)
+            sum += in(qx, qy, c);
+        out(x, y, c) = float(sum / count);
+      }
+  return out;
+}
+Image scaled(const Image& in, float factor) {
+  Image out = in;
+  for (float& v : out.values()) v *= factor;
+  return out;
+}
+
+struct Fixture {
+  EnsembleGuides guides;
+  std::vector<BaseOutputs> bases;
+  Image truth;
+};
+
+// A smooth truth with an edge, halves with independent noise, three bases per half.
+Fixture makeFixture(int w, int h, uint64_t seed, float noise = 0.3f) {
+  Fixture f;
+  f.truth = Image(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c)
+        f.truth(x, y, c) = 0.5f + 0.1f * c + (x > w / 2 ? 0.8f : 0.0f) + 0.02f * y;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<float> gauss(0.0f, noise);
+  f.guides.colorA = f.truth;
+  f.guides.colorB = f.truth;
+  for (float& v : f.guides.colorA.values()) v += gauss(rng);
+  for (float& v : f.guides.colorB.values()) v += gauss(rng);
+  f.guides.color = f.truth;
+  for (size_t e = 0; e < f.truth.size(); ++e)
+    f.guides.color.data()[e] = 0.5f * (f.guides.colorA.data()[e] + f.guides.colorB.data()[e]);
+  f.guides.albedo = Image(w, h, 3, 0.5f);
+  f.guides.normal = Image(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      f.guides.normal(x, y, 2) = 1.0f;
+      for (int c = 0; c < 3; ++c) f.guides.albedo(x, y, c) = x > w / 2 ? 0.8f : 0.3f;
+    }
+  const auto run = [&](const std::string& name, auto fn) {
+    f.bases.push_back({name, fn(f.guides.colorA), fn(f.guides.colorB), fn(f.guides.color)});
+  };
+  run("box1", [](const Image& in) { return boxBlur(in, 1); });
+  run("box3", [](const Image& in) { return boxBlur(in, 3); });
+  run("dim", [](const Image& in) { return scaled(boxBlur(in, 2), 0.9f); });
+  return f;
+}
+
+std::vector<const BaseOutputs*> pointers(const Fixture& f) {
+  return pointersTo(f.bases);
+}
+
+// The window's joint-bilateral weight k(p, q), in double.
+double windowWeight(const Fixture& f, const MseOptions& o, int x, int y, int qx, int qy) {
+  if (o.windowRadius == 0) return 1.0;
+  const double sigmaSpatial = o.windowSigmaSpatial > 0 ? o.windowSigmaSpatial : o.windowRadius;
+  double d = ((qx - x) * (qx - x) + (qy - y) * (qy - y)) / (2 * sigmaSpatial * sigmaSpatial);
+  for (int c = 0; c < 3; ++c) {
+    d += std::pow(f.guides.normal(x, y, c) - f.guides.normal(qx, qy, c), 2) /
+         (2.0 * o.windowSigmaNormal * o.windowSigmaNormal);
+    d += std::pow(f.guides.albedo(x, y, c) - f.guides.albedo(qx, qy, c), 2) /
+         (2.0 * o.windowSigmaAlbedo * o.windowSigmaAlbedo);
+  }
+  return std::exp(-d);
+}
+
+// ⟨M⟩ at one pixel straight from the definition, in double.
+PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
+  const int n = int(f.bases.size()), w = f.truth.width(), h = f.truth.height();
+  const int groups = o.form == MseForm::PerChannel ? 3 : 1;
+  PixelMse out;
+  out.groups = groups;
+  for (int g = 0; g < groups; ++g) out.h[size_t(g)] = MseMatrix::Zero(n, n);
+  double kernelSum = 0;
+  for (int qy = std::max(0, y - o.windowRadius); qy <= std::min(h - 1, y + o.windowRadius); ++qy)
+    for (int qx = std::max(0, x - o.windowRadius); qx <= std::min(w - 1, x + o.windowRadius);
+         ++qx) {
+      const double k = windowWeight(f, o, x, y, qx, qy);
+      kernelSum += k;
+      for (int c = 0; c < 3; ++c) {
+        const int g = groups == 3 ? c : 0;
+        const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
+        double weight = k;
+        if (o.relative) {
+          double mu = 0;
+          for (const BaseOutputs& b : f.bases) mu += b.full(qx, qy, c);
+          mu /= n;
+          weight /= mu * mu + kRelMseEpsilon;
+        }
+        for (int i = 0; i < n; ++i)
+          for (int j = 0; j < n; ++j) {
+            const double yAi = f.bases[size_t(i)].a(qx, qy, c),
+                         yAj = f.bases[size_t(j)].a(qx, qy, c);
+            const double yBi = f.bases[size_t(i)].b(qx, qy, c),
+                         yBj = f.bases[size_t(j)].b(qx, qy, c);
+            // The paper's form: ⟨M⟩^A = y^A y^Aᵀ − x^B (1 y^Aᵀ + y^A 1ᵀ) + x^A x^B 11ᵀ.
+            const double mA = yAi * yAj - xB * (yAi + yAj) + xA * xB;
+            const double mB = yBi * yBj - xA * (yBi + yBj) + xA * xB;
+            out.h[size_t(g)](i, j) += weight * 0.5 * (mA + mB);
+          }
+      }
+    }
+  for (int g = 0; g < groups; ++g) out.h[size_t(g)] /= kernelSum;
+  return out;
+}
+
+// ⟨M⟩ = h + c·11ᵀ as one matrix.
+MseMatrix full(const PixelMse& m, int g) {
+  return (m.h[size_t(g)].array() + m.constant[size_t(g)]).matrix();
+}
+
+TEST(MseEstimate, MatchesTheDefinition) {
+  const Fixture f = makeFixture(19, 14, 1);
+  for (MseForm form : {MseForm::PerChannel, MseForm::Summed})
+    for (int radius : {0, 2})
+      for (bool relative : {false, true}) {
+        MseOptions o;
+        o.form = form;
+        o.windowRadius = radius;
+        o.relative = relative;
+        const MseEstimator estimator(f.guides, pointers(f), o);
+        for (int y = 0; y < 14; y += 3)
+          for (int x = 0; x < 19; x += 2) {
+            const PixelMse got = estimator.at(x, y), expected = naiveMse(f, o, x, y);
+            ASSERT_EQ(got.groups, expected.groups);
+            EXPECT_EQ(got.valid, 0b111u);
+            for (int g = 0; g < got.groups; ++g) {
+              const MseMatrix m = full(got, g);
+              const double tolerance = 1e-5 * expected.h[size_t(g)].cwiseAbs().maxCoeff() + 1e-9;
+              for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                  ASSERT_NEAR(m(i, j), expected.h[size_t(g)](i, j), tolerance)
+                      << "form " << int(form) << " radius " << radius << " relative " << relative
+                      << " pixel " << x << "," << y << " entry " << i << j;
+              // The solver's part h is positive semi-definite.
+              const Eigen::MatrixXd h = got.h[size_t(g)];
+              EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(h).eigenvalues().minCoeff(),
+                        -1e-6 * h.trace());
+            }
+          }
+      }
+}
+
+// Image mean over pixels of ⟨M⟩ − T, per entry, with T the true half-buffer error matrix
+// ½((y^A − μ)(y^A − μ)ᵀ + (y^B − μ)(y^B − μ)ᵀ) averaged over the same window (the windowed
+// estimate is unbiased for the window's average error, not for the centre pixel's).
+std::vector<double> meanDeviation(const Fixture& f, const MseOptions& o) {
+  const MseEstimator estimator(f.guides, pointers(f), o);
+  const int n = 3, w = f.truth.width(), h = f.truth.height(), r = o.windowRadius;
+  const auto trueEntry = [&](int x, int y, int c, int i, int j) {
+    const double mu = f.truth(x, y, c);
+    const double a = (f.bases[size_t(i)].a(x, y, c) - mu) * (f.bases[size_t(j)].a(x, y, c) - mu);
+    const double b = (f.bases[size_t(i)].b(x, y, c) - mu) * (f.bases[size_t(j)].b(x, y, c) - mu);
+    return 0.5 * (a + b);
+  };
+  std::vector<double> sum(size_t(n * n), 0.0);
+  const MseRows rows = estimator.rows(0, h);
+  PixelMse m;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      rows.pixel(x, y, m);
+      for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < n; ++i)
+          for (int j = 0; j < n; ++j) {
+            double truth = 0, kernelSum = 0;
+            for (int qy = std::max(0, y - r); qy <= std::min(h - 1, y + r); ++qy)
+              for (int qx = std::max(0, x - r); qx <= std::min(w - 1, x + r); ++qx) {
+                const double k = windowWeight(f, o, x, y, qx, qy);
+                truth += k * trueEntry(qx, qy, c, i, j);
+                kernelSum += k;
+              }
+            sum[size_t(i * n + j)] += full(m, c)(i, j) - truth / kernelSum;
+          }
+    }
+  for (double& v : sum) v /= double(w) * h * 3;
+  return sum;
+}
+
+struct BiasCheck {
+  double worstZ = 0;  // largest |mean| / standard error over the entries
+};
+BiasCheck biasOverSeeds(int radius, bool leaky) {
+  constexpr int kSeeds = 300;
+  MseOptions o;
+  o.form = MseForm::PerChannel;
+  o.windowRadius = radius;
+  std::vector<double> sum(9, 0.0), sumSq(9, 0.0);
+  for (int s = 0; s < kSeeds; ++s) {
+    Fixture f = makeFixture(16, 12, 1000 + uint64_t(s));
+    if (leaky) {
+      // The estimator's premise broken: the "other half" is the same half, so x^B is not
+      // independent of y^A. The test must notice.
+      f.guides.colorB = f.guides.colorA;
+      for (BaseOutputs& b : f.bases) b.b = b.a;
+    }
+    const std::vector<double> d = meanDeviation(f, o);
+    for (size_t e = 0; e < 9; ++e) sum[e] += d[e], sumSq[e] += d[e] * d[e];
+  }
+  BiasCheck check;
+  for (size_t e = 0; e < 9; ++e) {
+    const double mean = sum[e] / kSeeds;
+    const double variance = (sumSq[e] - kSeeds * mean * mean) / (kSeeds - 1);
+    const double standardError = std::sqrt(variance / kSeeds);
+    check.worstZ = std::max(check.worstZ, std::abs(mean) / standardError);
+  }
+  return check;
+}
+
+TEST(MseEstimate, UnbiasedForTheHalfBufferErrorMatrix) {
+  // Per pixel and with a window: the mean over 300 noise seeds of every entry's deviation is
+  // within 3 standard errors of 0.
+  for (int radius : {0, 2}) EXPECT_LT(biasOverSeeds(radius, false).worstZ, 3.0) << radius;
+  // Negative control: the same statistic detects the bias of a leaky estimator.
+  EXPECT_GT(biasOverSeeds(0, true).worstZ, 10.0);
+}
+
+TEST(MseEstimate, OracleIsTheTrueErrorMatrix) {
+  const Fixture f = makeFixture(10, 8, 3);
+  MseOptions o;
+  o.form = MseForm::PerChannel;
+  o.windowRadius = 0;
+  const MseEstimator oracle = MseEstimator::oracle(f.guides, pointers(f), f.truth, o);
+  const PixelMse m = oracle.at(4, 5);
+  for (int c = 0; c < 3; ++c)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const double ei = f.bases[size_t(i)].full(4, 5, c) - f.truth(4, 5, c);
+        const double ej = f.bases[size_t(j)].full(4, 5, c) - f.truth(4, 5, c);
+        EXPECT_NEAR(full(m, c)(i, j), ei * ej, 1e-6 * (std::abs(ei * ej) + 1e-6));
+      }
+}
+
+TEST(MseEstimate, NonFiniteOutputsAreExcluded) {
+  Fixture f = makeFixture(12, 10, 4);
+  f.bases[1].a(5, 5, 0) = std::numeric_limits<float>::quiet_NaN();
+  f.bases[2].full(7, 2, 1) = std::numeric_limits<float>::infinity();
+  f.guides.colorB(2, 8, 2) = std::numeric_limits<float>::quiet_NaN();
+  for (int radius : {0, 2}) {
+    MseOptions o;
+    o.windowRadius = radius;
+    const MseEstimator estimator(f.guides, pointers(f), o);
+    EXPECT_EQ(estimator.at(5, 5).valid, 0b101u);
+    EXPECT_EQ(estimator.at(7, 2).valid, 0b011u);
+    EXPECT_EQ(estimator.at(6, 5).valid, 0b111u);
+    const MseRows rows = estimator.rows(0, 10);
+    PixelMse m;
+    for (int y = 0; y < 10; ++y)
+      for (int x = 0; x < 12; ++x) {
+        rows.pixel(x, y, m);
+        for (int g = 0; g < m.groups; ++g) {
+          ASSERT_TRUE(m.h[size_t(g)].allFinite()) << x << "," << y;
+          ASSERT_TRUE(std::isfinite(m.constant[size_t(g)]));
+        }
+      }
+    // The valid bases' entries at a pixel with an invalid base are those of the definition
+    // restricted to them (per pixel; with a window the pixel leaves its own window).
+    if (radius == 0) {
+      const PixelMse got = estimator.at(5, 5);
+      Fixture clean = makeFixture(12, 10, 4);
+      MseOptions summed;
+      summed.windowRadius = 0;
+      const PixelMse expected = naiveMse(clean, summed, 5, 5);
+      EXPECT_NEAR(full(got, 0)(0, 2), expected.h[0](0, 2), 1e-5 * std::abs(expected.h[0](0, 2)));
+    }
+  }
+}
+
+TEST(MseEstimate, ExtremeScales) {
+  const Fixture f = makeFixture(9, 7, 5);
+  MseOptions o;
+  const PixelMse reference = MseEstimator(f.guides, pointers(f), o).at(4, 3);
+  for (float factor : {1e-30f, 1e30f}) {
+    Fixture g = f;
+    for (Image* image : {&g.guides.color, &g.guides.colorA, &g.guides.colorB})
+      for (float& v : image->values()) v *= factor;
+    for (BaseOutputs& b : g.bases)
+      for (Image* image : {&b.a, &b.b, &b.full})
+        for (float& v : image->values()) v *= factor;
+    const PixelMse m = MseEstimator(g.guides, pointers(g), o).at(4, 3);
+    const double factor2 = double(factor) * factor;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        EXPECT_NEAR(m.h[0](i, j) / factor2, reference.h[0](i, j),
+                    1e-4 * reference.h[0].cwiseAbs().maxCoeff());
+  }
+}
+
+}  // namespace
+}  // namespace chorus

@@ -2,14 +2,15 @@
 
 #include <algorithm>
 
-#include "denoise/ensemble/fast_exp.h"
+#include "denoise/util/fast_exp.h"
 
 namespace chorus {
 namespace {
 
 constexpr float kVarianceFloor = 1e-6f;
 
-// Kernel values k[i] for the pixels x = x0 + i (i < count) of row y and offset (dx, dy).
+// Kernel values k[i] for the pixels x = x0 + i (i < count) of row y and offset (dx, dy): the
+// distances first (a loop that vectorises), then their exponentials.
 // Pointers start at p = (x0, y) and q = (x0 + dx, y + dy); plain int indexing so that the
 // loops vectorise.
 void kernelRow(const PlanarGuides& g, const BilateralKernel& kernel, int y, int dx, int dy, int x0,
@@ -38,17 +39,18 @@ void kernelRow(const PlanarGuides& g, const BilateralKernel& kernel, int y, int 
                   s2 = v2p[i] + v2q[i] + kVarianceFloor;
       const float color =
           (dz0 * dz0 * (s1 * s2) + dz1 * dz1 * (s0 * s2) + dz2 * dz2 * (s0 * s1)) / (s0 * s1 * s2);
-      k[i] = fastExpNegative(spatial + kn * (dn0 * dn0 + dn1 * dn1 + dn2 * dn2) +
-                             ka * (da0 * da0 + da1 * da1 + da2 * da2) + kc * color);
+      k[i] = (spatial + kn * (dn0 * dn0 + dn1 * dn1 + dn2 * dn2) +
+              ka * (da0 * da0 + da1 * da1 + da2 * da2) + kc * color);
     }
   } else {
     for (int i = 0; i < count; ++i) {
       const float dn0 = n0p[i] - n0q[i], dn1 = n1p[i] - n1q[i], dn2 = n2p[i] - n2q[i];
       const float da0 = a0p[i] - a0q[i], da1 = a1p[i] - a1q[i], da2 = a2p[i] - a2q[i];
-      k[i] = fastExpNegative(spatial + kn * (dn0 * dn0 + dn1 * dn1 + dn2 * dn2) +
-                             ka * (da0 * da0 + da1 * da1 + da2 * da2));
+      k[i] = (spatial + kn * (dn0 * dn0 + dn1 * dn1 + dn2 * dn2) +
+              ka * (da0 * da0 + da1 * da1 + da2 * da2));
     }
   }
+  fastExpNegated(k, k, count);
 }
 
 }  // namespace

@@ -7,8 +7,8 @@
 //   out(p) = Σ_q k(p,q) in(q) / Σ_q k(p,q),   |q − p|∞ ≤ radius, q inside the image.
 //
 // Loops run over offsets and then over contiguous x, so that they vectorise (the exponential
-// is fastExpNegative). Each output value is one fixed-order sum: results do not depend on how
-// rows are split between threads.
+// is fastExpNegated, denoise/util/fast_exp.h). Each output value is one fixed-order sum: results do
+// not depend on how rows are split between threads.
 #include <span>
 #include <vector>
 

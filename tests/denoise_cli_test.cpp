@@ -1,0 +1,197 @@
+// `chorus denoise` end to end on synthetic inputs: a directory of base outputs (the ensemble
+// paper's layout) and a render.exr with the registered base denoisers; the written files,
+// stats.json, and clean failures (one line naming the problem, exit code ≠ 0).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "denoise/base/registry.h"
+#include "denoise/buffers/buffers_exr.h"
+#include "denoise/ensemble/combiners.h"
+#include "denoise/ensemble/outputs_directory.h"
+#include "denoise/ensemble/synthetic_cases.h"
+#include "denoise/image/exr_io.h"
+#include "denoise/metrics/metrics.h"
+#include "tests/support/test_support.h"
+
+namespace chorus {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using test::runChorus;
+using test::TempDir;
+
+int lineCount(const std::string& s) {
+  return int(std::count(s.begin(), s.end(), '\n'));
+}
+
+json readJson(const fs::path& path) {
+  std::ifstream in(path);
+  return json::parse(in);
+}
+
+std::vector<std::string> layerNames(const fs::path& path) {
+  std::vector<std::string> names;
+  for (const ExrLayer& layer : readExr(path)) names.push_back(layer.name);
+  return names;
+}
+
+// A synthetic case written in the outputs layout, with its expected value as reference.
+struct OutputsFixture {
+  TempDir dir{"chorus_denoise_cli"};
+  synthetic::PreparedCase prepared;
+  fs::path input, reference;
+  OutputsFixture() {
+    synthetic::Case c = synthetic::standardCases()[3];  // regions, noise 1, five members
+    c.members = {"box1", "guided", "nlm"};
+    prepared = synthetic::prepareCase(c, 40, 32);
+    input = dir / "outputs";
+    writeOutputsDirectory(input, prepared.guides, prepared.bases);
+    reference = dir / "reference.exr";
+    writeExr(reference, prepared.truth);
+  }
+};
+
+TEST(DenoiseCli, OutputsDirectoryWithReference) {
+  OutputsFixture f;
+  const fs::path out = f.dir / "out";
+  const auto r = runChorus({"denoise", f.input.string(), "--methods", "box1,guided,nlm",
+                            "--combine", "ensemble,average,oracle", "--reference",
+                            f.reference.string(), "--out", out.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  for (const char* name :
+       {"ensemble.exr", "ensemble.png", "average.exr", "average.png", "oracle.exr", "weights.exr",
+        "weights-average.exr", "box1.exr", "guided.exr", "nlm.exr", "stats.json"})
+    EXPECT_TRUE(fs::is_regular_file(out / name)) << name;
+  EXPECT_EQ(layerNames(out / "ensemble.exr"),
+            (std::vector<std::string>{"", "A", "B", "mseEstimate"}));
+  EXPECT_EQ(layerNames(out / "weights.exr"), (std::vector<std::string>{"box1", "guided", "nlm"}));
+  EXPECT_EQ(layerNames(out / "box1.exr"), (std::vector<std::string>{"", "A", "B"}));
+
+  // The file is what the library computes with the same (default) options.
+  const Image written = readExrLayer(out / "ensemble.exr");
+  const CombineResult direct =
+      combine(f.prepared.guides, pointersTo(f.prepared.bases), CombineOptions{});
+  EXPECT_TRUE(
+      std::equal(written.values().begin(), written.values().end(), direct.image.values().begin()));
+
+  const json stats = readJson(out / "stats.json");
+  EXPECT_EQ(stats["input_kind"], "outputs directory");
+  EXPECT_EQ(stats["width"], 40);
+  for (const char* stage : {"read", "ensemble/solve", "ensemble/filter", "ensemble/blend",
+                            "average/solve", "oracle/solve", "total"})
+    EXPECT_TRUE(stats["seconds"].contains(stage)) << stage;
+  const json& m = stats["metrics"];
+  for (const char* key : {"noisy", "box1", "guided", "nlm", "ensemble", "average", "oracle"})
+    EXPECT_TRUE(m.contains(key)) << key;
+  EXPECT_NEAR(m["ensemble"]["relmse"].get<double>(), relMse(written, f.prepared.truth), 1e-9);
+  EXPECT_NEAR(m["guided"]["relmse"].get<double>(),
+              relMse(f.prepared.bases[1].full, f.prepared.truth), 1e-9);
+  EXPECT_LT(m["ensemble"]["relmse"].get<double>(), m["noisy"]["relmse"].get<double>());
+  EXPECT_LE(m["oracle"]["relmse"].get<double>(), m["ensemble"]["relmse"].get<double>());
+}
+
+TEST(DenoiseCli, OptionsReachTheLibrary) {
+  OutputsFixture f;
+  const fs::path out = f.dir / "out";
+  const auto r = runChorus({"denoise", f.input.string(), "--methods", "box1,nlm", "--mse",
+                            "per-channel", "--window", "0", "--weight-filter", "none", "--solver",
+                            "pairwise", "--seed", "5", "--relative", "--out", out.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  CombineOptions o;
+  o.mse.form = MseForm::PerChannel;
+  o.mse.windowRadius = 0;
+  o.mse.relative = true;
+  o.filter.enabled = false;
+  o.solver = SolverKind::Pairwise;
+  o.seed = 5;
+  const std::vector<const BaseOutputs*> bases = {&f.prepared.bases[0], &f.prepared.bases[2]};
+  const CombineResult direct = combine(f.prepared.guides, bases, o);
+  const Image written = readExrLayer(out / "ensemble.exr");
+  EXPECT_TRUE(
+      std::equal(written.values().begin(), written.values().end(), direct.image.values().begin()));
+  EXPECT_EQ(readExrLayer(out / "weights.exr", "box1").channels(), 3);  // per channel
+}
+
+TEST(DenoiseCli, CleanFailures) {
+  OutputsFixture f;
+  const fs::path out = f.dir / "out";
+  const auto expectOneLine = [&](std::vector<std::string> args, const std::string& needle) {
+    args.insert(args.begin(), "denoise");
+    const auto r = runChorus(args);
+    EXPECT_NE(r.exitCode, 0) << needle;
+    EXPECT_EQ(lineCount(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
+  };
+  const std::string in = f.input.string();
+  expectOneLine({in, "--methods", "box1,oidn", "--out", out.string()},
+                "oidn: missing method folder");
+  expectOneLine({in, "--methods", "box1", "--combine", "best", "--out", out.string()},
+                "unknown combiner 'best'");
+  expectOneLine({in, "--methods", "box1", "--combine", "oracle", "--out", out.string()},
+                "needs --reference");
+  expectOneLine({in, "--methods", "box1", "--mse", "diagonal", "--out", out.string()},
+                "unknown --mse");
+  expectOneLine({(f.dir / "nothing").string(), "--methods", "box1", "--out", out.string()},
+                "no such file or directory");
+  // A method file of another size.
+  writeExr(f.input / "nlm" / "nlmA.exr", Image(8, 8, 3));
+  expectOneLine({in, "--methods", "box1,nlm", "--out", out.string()}, "nlmA.exr: is 8x8");
+  // A reference of another size.
+  writeExr(f.dir / "small.exr", Image(8, 8, 3));
+  expectOneLine({in, "--methods", "box1", "--reference", (f.dir / "small.exr").string(), "--out",
+                 out.string()},
+                "small.exr: is 8x8x3");
+  EXPECT_FALSE(fs::exists(out / "stats.json"));
+}
+
+// A render.exr written from K sub-buffers of a synthetic scene.
+fs::path writeRender(const TempDir& dir, int splits) {
+  const synthetic::Scene scene = synthetic::makeScene(synthetic::SceneKind::Shadows, 36, 28);
+  const SampleBuffers buffers = synthetic::renderBuffers(scene, {1.0f, 4, 0.0f}, splits, 4);
+  const fs::path path = dir / ("render" + std::to_string(splits) + ".exr");
+  writeExr(path, sampleBuffersToLayers(buffers));
+  return path;
+}
+
+TEST(DenoiseCli, RenderExrWithRegisteredDenoisers) {
+  std::vector<std::string> names;
+  for (const DenoiserEntry& entry : builtinDenoisers())
+    if (!createDenoiser(entry.name)->requirements().halves) names.push_back(entry.name);
+  if (names.empty()) GTEST_SKIP() << "no registered base denoiser yet";
+  if (names.size() > 2) names.resize(2);
+  std::string methods;
+  for (const std::string& n : names) methods += (methods.empty() ? "" : ",") + n;
+
+  TempDir dir("chorus_denoise_render");
+  const fs::path render = writeRender(dir, 4), out = dir / "out";
+  const auto r =
+      runChorus({"denoise", render.string(), "--methods", methods, "--out", out.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const json stats = readJson(out / "stats.json");
+  EXPECT_EQ(stats["input_kind"], "render.exr");
+  for (const std::string& n : names) {
+    EXPECT_TRUE(fs::is_regular_file(out / (n + ".exr"))) << n;
+    for (const char* part : {"/A", "/B", "/full"})
+      EXPECT_TRUE(stats["seconds"].contains(n + part)) << n << part;
+  }
+  const Image result = readExrLayer(out / "ensemble.exr");
+  EXPECT_EQ(result.width(), 36);
+  for (float v : result.values()) ASSERT_TRUE(std::isfinite(v));
+
+  // One sub-buffer cannot be split into halves; unknown methods are named.
+  const fs::path single = writeRender(dir, 1);
+  auto bad = runChorus({"denoise", single.string(), "--methods", methods, "--out", out.string()});
+  EXPECT_EQ(bad.exitCode, 2);
+  EXPECT_NE(bad.err.find("independent sub-buffers"), std::string::npos) << bad.err;
+  bad =
+      runChorus({"denoise", render.string(), "--methods", "nosuchdenoiser", "--out", out.string()});
+  EXPECT_EQ(bad.exitCode, 2);
+  EXPECT_NE(bad.err.find("unknown denoiser 'nosuchdenoiser'"), std::string::npos) << bad.err;
+}
+
+}  // namespace
+}  // namespace chorus

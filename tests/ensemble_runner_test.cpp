@@ -1,0 +1,165 @@
+// The Ensemble runner: runs every member on half A, half B and the full buffer (exactly what
+// running the denoiser on SampleBuffers::input(part) gives), combines, reports every stage's
+// time, refuses members that cannot run on the given sub-buffers, and is deterministic.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <set>
+
+#include "denoise/ensemble/ensemble.h"
+#include "denoise/ensemble/synthetic_cases.h"
+#include "denoise/metrics/metrics.h"
+#include "denoise/util/error.h"
+
+namespace chorus {
+namespace {
+
+// A plain box filter: the test-only base denoiser.
+class BoxDenoiser : public BaseDenoiser {
+ public:
+  explicit BoxDenoiser(int radius) : radius_(radius) {}
+  std::string name() const override { return "box" + std::to_string(radius_); }
+  DenoiserRequirements requirements() const override { return {}; }
+  Image run(const DenoiseInput& input) const override {
+    const Image& in = input.whole.color.mean;
+    Image out(in.width(), in.height(), 3);
+    for (int y = 0; y < in.height(); ++y)
+      for (int x = 0; x < in.width(); ++x)
+        for (int c = 0; c < 3; ++c) {
+          double sum = 0;
+          int count = 0;
+          for (int qy = std::max(0, y - radius_); qy <= std::min(in.height() - 1, y + radius_);
+               ++qy)
+            for (int qx = std::max(0, x - radius_); qx <= std::min(in.width() - 1, x + radius_);
+                 ++qx, ++count)
+              sum += in(qx, qy, c);
+          out(x, y, c) = float(sum / count);
+        }
+    return out;
+  }
+
+ private:
+  int radius_;
+};
+
+// Needs two halves of its input (like NFOR): averages them, so its output equals the whole.
+class HalvesDenoiser : public BaseDenoiser {
+ public:
+  std::string name() const override { return "halves"; }
+  DenoiserRequirements requirements() const override { return {false, true}; }
+  Image run(const DenoiseInput& input) const override {
+    if (!input.halves) throw Error("HalvesDenoiser: no halves");
+    Image out = (*input.halves)[0].color.mean;
+    const Image& other = (*input.halves)[1].color.mean;
+    for (size_t e = 0; e < out.size(); ++e)
+      out.data()[e] = 0.5f * (out.data()[e] + other.data()[e]);
+    return out;
+  }
+};
+
+SampleBuffers buffers(int splits, uint64_t seed = 9) {
+  const synthetic::Scene scene = synthetic::makeScene(synthetic::SceneKind::Regions, 30, 22);
+  return synthetic::renderBuffers(scene, {1.0f, 4, 0.0f}, splits, seed);
+}
+
+std::vector<EnsembleMember> boxMembers() {
+  return {{"box1", std::make_shared<BoxDenoiser>(1)}, {"box3", std::make_shared<BoxDenoiser>(3)}};
+}
+
+bool sameImage(const Image& a, const Image& b) {
+  return a.sameShape(b) && std::equal(a.values().begin(), a.values().end(), b.values().begin());
+}
+
+TEST(EnsembleRunner, RunsEveryMemberOnHalfAHalfBAndFull) {
+  const SampleBuffers b = buffers(4);
+  const Ensemble ensemble(boxMembers(), {});
+  const EnsembleResult result = ensemble.run(b);
+  ASSERT_EQ(result.bases.size(), 2u);
+  const BoxDenoiser box1(1), box3(3);
+  EXPECT_EQ(result.bases[0].name, "box1");
+  EXPECT_TRUE(sameImage(result.bases[0].a, box1.run(b.input(BufferPart::HalfA))));
+  EXPECT_TRUE(sameImage(result.bases[0].b, box1.run(b.input(BufferPart::HalfB))));
+  EXPECT_TRUE(sameImage(result.bases[1].full, box3.run(b.input(BufferPart::Full))));
+  // The guides are the noisy halves, and the combination is combine() on those outputs.
+  EXPECT_TRUE(sameImage(result.guides.colorA, b.part(BufferPart::HalfA).color.mean));
+  EXPECT_TRUE(sameImage(result.guides.colorB, b.part(BufferPart::HalfB).color.mean));
+  const CombineResult direct = combine(result.guides, pointersTo(result.bases), {});
+  EXPECT_TRUE(sameImage(result.combined.image, direct.image));
+  // Every stage is timed.
+  std::set<std::string> stages;
+  for (const StageTime& t : result.times) {
+    stages.insert(t.stage);
+    EXPECT_GE(t.seconds, 0.0);
+  }
+  for (const char* stage : {"box1/A", "box1/B", "box1/full", "box3/A", "box3/B", "box3/full",
+                            "bases", "solve", "filter", "blend"})
+    EXPECT_TRUE(stages.count(stage)) << stage;
+}
+
+TEST(EnsembleRunner, HalvesOfTheirOwnInputNeedFourSubBuffers) {
+  std::vector<EnsembleMember> members = boxMembers();
+  members.push_back({"halves", std::make_shared<HalvesDenoiser>()});
+  const Ensemble ensemble(members, {});
+  // K = 4: the half runs get quarters as their halves.
+  const SampleBuffers four = buffers(4);
+  const EnsembleResult result = ensemble.run(four);
+  EXPECT_TRUE(sameImage(result.bases[2].a, HalvesDenoiser().run(four.input(BufferPart::HalfA))));
+  // K = 2: a clear error naming the member.
+  try {
+    ensemble.run(buffers(2));
+    FAIL() << "expected chorus::Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'halves' needs two independent halves"),
+              std::string::npos)
+        << e.what();
+  }
+  // Members without that need run on K = 2, and on a Tungsten-style input with two halves.
+  EXPECT_NO_THROW(Ensemble(boxMembers(), {}).run(buffers(2)));
+  const SampleBuffers two = buffers(2);
+  const EnsembleSources sources = sourcesFromHalves(two.input(BufferPart::Full));
+  EXPECT_TRUE(sameImage(sources.a.whole.color.mean, two.sub(0).color.mean));
+  EXPECT_NO_THROW(Ensemble(boxMembers(), {}).run(sources));
+  EXPECT_THROW(ensemble.run(sources), Error);
+  // One sub-buffer cannot be split at all.
+  EXPECT_THROW(Ensemble(boxMembers(), {}).run(buffers(1)), Error);
+}
+
+TEST(EnsembleRunner, RejectsBadMemberLists) {
+  EXPECT_THROW(Ensemble({}, {}).run(buffers(4)), Error);
+  std::vector<EnsembleMember> twice = {{"box", std::make_shared<BoxDenoiser>(1)},
+                                       {"box", std::make_shared<BoxDenoiser>(2)}};
+  EXPECT_THROW(Ensemble(twice, {}).run(buffers(4)), Error);
+}
+
+TEST(EnsembleRunner, SameResultForAnyThreadCount) {
+  const SampleBuffers b = buffers(4);
+  EnsembleResult one, two;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = Ensemble(boxMembers(), {}).run(b);
+  }
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+    two = Ensemble(boxMembers(), {}).run(b);
+  }
+  EXPECT_TRUE(sameImage(one.combined.image, two.combined.image));
+  for (size_t i = 0; i < one.combined.weights.size(); ++i)
+    EXPECT_TRUE(sameImage(one.combined.weights[i], two.combined.weights[i]));
+}
+
+TEST(EnsembleRunner, BetterThanItsMembersOnANoisyRender) {
+  // The box filters' errors differ in space (3×3 keeps edges, 7×7 removes noise): the ensemble
+  // beats both against the expected value.
+  const synthetic::Scene scene = synthetic::makeScene(synthetic::SceneKind::Shadows, 48, 40);
+  const synthetic::NoiseModel model{1.0f, 4, 0.0f};
+  const SampleBuffers b = synthetic::renderBuffers(scene, model, 4, 3);
+  const EnsembleResult result = Ensemble(boxMembers(), {}).run(b);
+  const Image truth = synthetic::expectedValue(scene, model);
+  const double ensemble = relMse(result.combined.image, truth);
+  for (const BaseOutputs& base : result.bases)
+    EXPECT_LT(ensemble, relMse(base.full, truth)) << base.name;
+}
+
+}  // namespace
+}  // namespace chorus

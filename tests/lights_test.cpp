@@ -4,11 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <random>
 
+#include "denoise/image/exr_io.h"
+#include "denoise/util/error.h"
 #include "renderer/integrator/environment_light.h"
 #include "renderer/integrator/lights.h"
 #include "renderer/scene/scene.h"
+#include "tests/support/test_support.h"
 
 namespace chorus::render {
 namespace {
@@ -115,6 +119,26 @@ TEST(Lights, PunctualLightsFollowInverseSquareAndSpotCone) {
   EXPECT_LT(edge->Li.r, 0.95f * full);
 }
 
+TEST(Lights, DirectionalLightIsADeltaFromItsDirection) {
+  SceneDesc desc = squareEmitterScene(0.0f, 0.0f, Rgb(0.0f));
+  PunctualLightDesc sun;
+  sun.type = PunctualLightType::Directional;
+  sun.direction = normalize(Vec3f{1, -2, 0});
+  sun.intensity = 3.0f;
+  sun.color = {1.0f, 0.5f, 0.25f};
+  desc.lights.push_back(sun);
+  const Scene scene = buildScene(desc, EnvironmentDesc{});
+  const auto s = LightSet(scene).sample({5, 5, 5}, 0.7f, {0.1f, 0.9f});
+  ASSERT_TRUE(s);
+  EXPECT_TRUE(s->isDelta);
+  EXPECT_TRUE(s->isInfinite);
+  EXPECT_FLOAT_EQ(s->pdf, 1.0f);
+  EXPECT_NEAR(s->wi.x, -sun.direction.x, 1e-6f);
+  EXPECT_NEAR(s->wi.y, -sun.direction.y, 1e-6f);
+  EXPECT_FLOAT_EQ(s->Li.r, 3.0f);
+  EXPECT_FLOAT_EQ(s->Li.b, 0.75f);
+}
+
 Image oneBrightTexel(int w, int h, int bx, int by) {
   Image image(w, h, 3, 0.0f);
   for (int c = 0; c < 3; ++c) image(bx, by, c) = 100.0f;
@@ -203,6 +227,24 @@ TEST(EnvironmentLight, ImportanceSampledIntegralMatchesTexelSum) {
     sum += s->Le.r / s->pdfSolidAngle;
   }
   EXPECT_NEAR(sum / n / exact, 1.0, 0.005);
+}
+
+TEST(EnvironmentLight, ReadsExrAndHdrFilesAndRejectsOthers) {
+  test::TempDir dir;
+  Image image(8, 4, 3, 0.5f);
+  image(3, 1, 0) = -1.0f;  // negative texels become 0
+  writeExr(dir / "env.exr", image);
+  const EnvironmentDesc e = environmentFromFile(dir / "env.exr", 0.0f, 2.0f);
+  ASSERT_EQ(e.kind, EnvironmentDesc::Kind::Map);
+  EXPECT_EQ(e.map->width(), 8);
+  EXPECT_EQ(e.map->at(3, 1, 0), 0.0f);
+  const EnvironmentLight light(e);
+  EXPECT_FLOAT_EQ(light.Le({0, -1, 0}).g, 1.0f);  // 0.5 × intensity 2
+  std::ofstream(dir / "env.png") << "not an environment";
+  EXPECT_THROW(environmentFromFile(dir / "env.png"), Error);
+  EXPECT_THROW(environmentFromFile(dir / "missing.hdr"), Error);
+  std::ofstream(dir / "bad.hdr") << "#?RADIANCE\ngarbage";
+  EXPECT_THROW(environmentFromFile(dir / "bad.hdr"), Error);
 }
 
 TEST(EnvironmentLight, ConstantIsUniform) {

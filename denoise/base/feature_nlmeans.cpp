@@ -44,38 +44,28 @@ void fillMask(const PixelRect& area, const PixelRect& valid, float* mask) {
 // dst (over `out`) = box mean of src (over `in`, which contains `out` grown by r) of radius r,
 // each sum divided by the number of pixels of `valid` in the box (src is 0 outside `valid`).
 void boxMean(const float* src, const PixelRect& in, float* dst, const PixelRect& out, int r,
-             const PixelRect& valid, std::vector<float>& rowSums) {
+             const PixelRect& valid, std::vector<float>& rowSums, std::vector<float>& invX) {
   const int ow = out.width(), iw = in.width();
   rowSums.resize(size_t(ow) * size_t(out.height() + 2 * r));
-  for (int y = out.y0 - r; y < out.y1 + r; ++y) {
-    const float* s = src + size_t(y - in.y0) * size_t(iw) + size_t(out.x0 - in.x0);
-    float* h = rowSums.data() + size_t(y - out.y0 + r) * size_t(ow);
-    for (int i = 0; i < ow; ++i) h[i] = s[i - r];
-    for (int j = -r + 1; j <= r; ++j)
-      for (int i = 0; i < ow; ++i) h[i] += s[i + j];
-  }
-  std::vector<float> invX(static_cast<size_t>(ow));
+  for (int y = out.y0 - r; y < out.y1 + r; ++y)
+    rows::horizontalBoxSum(ow, src + size_t(y - in.y0) * size_t(iw) + size_t(out.x0 - in.x0), r,
+                           rowSums.data() + size_t(y - out.y0 + r) * size_t(ow));
+  invX.resize(size_t(ow));
   for (int i = 0; i < ow; ++i) {
     const int n = boxOverlap(out.x0 + i, r, valid.x0, valid.x1);
     invX[size_t(i)] = n > 0 ? 1.0f / float(n) : 0.0f;
   }
   for (int y = out.y0; y < out.y1; ++y) {
-    float* d = dst + size_t(y - out.y0) * size_t(ow);
-    const float* first = rowSums.data() + size_t(y - out.y0) * size_t(ow);
-    for (int i = 0; i < ow; ++i) d[i] = first[i];
-    for (int j = 1; j <= 2 * r; ++j) {
-      const float* h = rowSums.data() + size_t(y - out.y0 + j) * size_t(ow);
-      for (int i = 0; i < ow; ++i) d[i] += h[i];
-    }
     const int ny = boxOverlap(y, r, valid.y0, valid.y1);
-    const float invY = ny > 0 ? 1.0f / float(ny) : 0.0f;
-    for (int i = 0; i < ow; ++i) d[i] *= invY * invX[size_t(i)];
+    rows::verticalBoxMean(ow, rowSums.data() + size_t(y - out.y0) * size_t(ow), size_t(ow),
+                          2 * r + 1, ny > 0 ? 1.0f / float(ny) : 0.0f, invX.data(),
+                          dst + size_t(y - out.y0) * size_t(ow));
   }
 }
 
 struct TileMemory {
   std::vector<float> mask[3], featPlus, featMinus, termRow[3];
-  std::vector<float> ext[3], dist[3], gridMask[3], gridPlus, gridMinus, rowSums;
+  std::vector<float> ext[3], dist[3], gridMask[3], gridPlus, gridMinus, rowSums, invX;
   std::vector<float> patchPlus, patchMinus, wPlus, wMinus;
   std::vector<float> weightSum, maxWeight;
   std::vector<float> acc;  // every data channel, one plane each
@@ -255,7 +245,7 @@ void FeatureNlMeansKernel::patchWeights(const PixelRect& tile, int dx, int dy,
   const ValidRects valid(width_, height_, dx, dy);
   const PixelRect grid = tile.grown(box_), ext = grid.grown(f_);
   const int ew = ext.width(), gw = grid.width();
-  const size_t eArea = size_t(ext.area()), gArea = size_t(grid.area());
+  const size_t eArea = size_t(ext.area());
   for (auto& e : m.ext) std::fill(e.begin(), e.begin() + ptrdiff_t(eArea), 0.0f);
   const float share = 1.0f / float(patchChannels_);
   const int ox = ext.x0;
@@ -276,7 +266,8 @@ void FeatureNlMeansKernel::patchWeights(const PixelRect& tile, int dx, int dy,
   for (int kind = 0; kind < 3; ++kind) {
     fillMask(ext, valid.rect[kind], m.gridMask[kind].data());  // scratch: the ext mask
     for (size_t i = 0; i < eArea; ++i) m.ext[kind][i] *= m.gridMask[kind][i];
-    boxMean(m.ext[kind].data(), ext, m.dist[kind].data(), grid, f_, valid.rect[kind], m.rowSums);
+    boxMean(m.ext[kind].data(), ext, m.dist[kind].data(), grid, f_, valid.rect[kind], m.rowSums,
+            m.invX);
     fillMask(grid, valid.rect[kind], m.gridMask[kind].data());
   }
   for (int y = grid.y0; y < grid.y1; ++y) {
@@ -286,12 +277,12 @@ void FeatureNlMeansKernel::patchWeights(const PixelRect& tile, int dx, int dy,
                        m.gridMask[kMinus].data() + r, m.gridMask[kSym].data() + r, refineMinWeight_,
                        m.gridPlus.data() + r, m.gridMinus.data() + r);
   }
-  (void)gArea;
   // "Patchwise": the weights themselves box-filtered over the valid pixels.
   if (box_ > 0) {
-    boxMean(m.gridPlus.data(), grid, m.patchPlus.data(), tile, box_, valid.rect[kPlus], m.rowSums);
+    boxMean(m.gridPlus.data(), grid, m.patchPlus.data(), tile, box_, valid.rect[kPlus], m.rowSums,
+            m.invX);
     boxMean(m.gridMinus.data(), grid, m.patchMinus.data(), tile, box_, valid.rect[kMinus],
-            m.rowSums);
+            m.rowSums, m.invX);
   } else {
     std::copy(m.gridPlus.begin(), m.gridPlus.begin() + ptrdiff_t(tile.area()), m.patchPlus.begin());
     std::copy(m.gridMinus.begin(), m.gridMinus.begin() + ptrdiff_t(tile.area()),

@@ -1,19 +1,22 @@
 #include "denoise/base/nlmeans_row_kernels.h"
 
-// Floating-point operations never trap here (no FP exceptions are enabled in chorus), which lets
-// GCC turn the selects of these loops (clamps, refinement) into vector blends. It changes no
-// result: the same IEEE operations are evaluated.
+// Floating-point operations never trap in chorus (no FP exceptions are enabled), which lets GCC
+// turn the selects of these loops (clamps, refinement) into vector blends. It changes no value:
+// the same IEEE operations are evaluated, so the inline functions of the headers below, which
+// must be compiled the same way to be inlined into the loops, give the same results in every
+// translation unit.
 #pragma GCC optimize("no-trapping-math")
 
 #include <algorithm>
 
 #include "denoise/base/filters/fast_exp.h"
 
-// AVX2 and baseline builds of every kernel (GCC function multiversioning through ifunc).
+// AVX-512F, AVX2 and baseline builds of every kernel (GCC function multiversioning through
+// ifunc); -mavx512f and -mavx2 do not enable FMA, so no contraction changes a result.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define RDFC_KERNEL __attribute__((target_clones("avx2", "default")))
+#define ROW_KERNEL __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
-#define RDFC_KERNEL
+#define ROW_KERNEL
 #endif
 
 namespace chorus::rows {
@@ -40,7 +43,7 @@ inline float refineFactor(float w1, float w2, float ws, float mask, float minWei
 
 }  // namespace
 
-RDFC_KERNEL
+ROW_KERNEL
 void addPairDistance(int n, const float* __restrict f, const float* __restrict fq,
                      const float* __restrict vn, const float* __restrict vnq,
                      const float* __restrict denA, const float* __restrict denAq,
@@ -54,7 +57,7 @@ void addPairDistance(int n, const float* __restrict f, const float* __restrict f
   }
 }
 
-RDFC_KERNEL
+ROW_KERNEL
 void addSymmetricDistance(int n, const float* __restrict f, const float* __restrict fp,
                           const float* __restrict fm, const float* __restrict vn,
                           const float* __restrict vnp, const float* __restrict vnm,
@@ -71,7 +74,7 @@ void addSymmetricDistance(int n, const float* __restrict f, const float* __restr
   }
 }
 
-RDFC_KERNEL
+ROW_KERNEL
 void minTermWeights(int n, float scale, const float* __restrict dPlus,
                     const float* __restrict dMinus, const float* __restrict dSym,
                     const float* __restrict symMask, float minRefineWeight,
@@ -85,7 +88,7 @@ void minTermWeights(int n, float scale, const float* __restrict dPlus,
   }
 }
 
-RDFC_KERNEL
+ROW_KERNEL
 void addColorDistances(int n, const float* __restrict g, const float* __restrict gp,
                        const float* __restrict gm, const float* __restrict vn,
                        const float* __restrict vnp, const float* __restrict vnm,
@@ -119,7 +122,7 @@ void addColorDistances(int n, const float* __restrict g, const float* __restrict
   }
 }
 
-RDFC_KERNEL
+ROW_KERNEL
 void addFeatureDistances(int n, const float* __restrict f, const float* __restrict fp,
                          const float* __restrict fm, const float* __restrict vn,
                          const float* __restrict vnp, const float* __restrict vnm,
@@ -146,18 +149,36 @@ void addFeatureDistances(int n, const float* __restrict f, const float* __restri
   }
 }
 
-RDFC_KERNEL
+ROW_KERNEL
+void horizontalBoxSum(int n, const float* __restrict src, int r, float* __restrict dst) {
+  for (int i = 0; i < n; ++i) dst[i] = src[i - r];
+  for (int j = -r + 1; j <= r; ++j)
+    for (int i = 0; i < n; ++i) dst[i] += src[i + j];
+}
+
+ROW_KERNEL
+void verticalBoxMean(int n, const float* __restrict src, size_t stride, int count, float scaleY,
+                     const float* __restrict scaleX, float* __restrict dst) {
+  for (int i = 0; i < n; ++i) dst[i] = src[i];
+  for (int j = 1; j < count; ++j) {
+    const float* __restrict row = src + size_t(j) * stride;
+    for (int i = 0; i < n; ++i) dst[i] += row[i];
+  }
+  for (int i = 0; i < n; ++i) dst[i] *= scaleY * scaleX[i];
+}
+
+ROW_KERNEL
 void maxScaled(int n, float scale, const float* __restrict src, float* __restrict dst) {
   for (int i = 0; i < n; ++i) dst[i] = std::max(dst[i], scale * src[i]);
 }
 
-RDFC_KERNEL
+ROW_KERNEL
 void maskedWeights(int n, const float* __restrict d, const float* __restrict mask,
                    float* __restrict w) {
   for (int i = 0; i < n; ++i) w[i] = mask[i] * weightOf(d[i]);
 }
 
-RDFC_KERNEL
+ROW_KERNEL
 void patchWeights(int n, const float* __restrict dPlus, const float* __restrict dMinus,
                   const float* __restrict dSym, const float* __restrict maskPlus,
                   const float* __restrict maskMinus, const float* __restrict maskSym,
@@ -171,7 +192,7 @@ void patchWeights(int n, const float* __restrict dPlus, const float* __restrict 
   }
 }
 
-RDFC_KERNEL
+ROW_KERNEL
 void nearColorSlopes(int n, const float* __restrict g, const float* __restrict gp,
                      const float* __restrict gm, const float* __restrict g2p,
                      const float* __restrict g2m, const float* __restrict vd,
@@ -196,7 +217,7 @@ void nearColorSlopes(int n, const float* __restrict g, const float* __restrict g
   }
 }
 
-RDFC_KERNEL
+ROW_KERNEL
 void colorCandidateWeights(int n, const float* __restrict dPlus, const float* __restrict dMinus,
                            const float* __restrict dSym, const float* __restrict invCountPlus,
                            const float* __restrict invCountMinus,
@@ -237,7 +258,7 @@ void colorCandidateWeights(int n, const float* __restrict dPlus, const float* __
   }
 }
 
-RDFC_KERNEL
+ROW_KERNEL
 void accumulateColorDerivative(int n, const float* __restrict tw1, const float* __restrict tw2,
                                const float* __restrict tws, const float* __restrict tk1,
                                const float* __restrict tk2, const float* __restrict tks,
@@ -262,7 +283,7 @@ void accumulateColorDerivative(int n, const float* __restrict tw1, const float* 
   }
 }
 
-RDFC_KERNEL
+ROW_KERNEL
 void accumulateWeightSums(int n, const float* __restrict wPlus, const float* __restrict wMinus,
                           float* __restrict weightSum, float* __restrict maxWeight) {
   for (int i = 0; i < n; ++i) {
@@ -271,7 +292,7 @@ void accumulateWeightSums(int n, const float* __restrict wPlus, const float* __r
   }
 }
 
-RDFC_KERNEL
+ROW_KERNEL
 void accumulateData(int n, const float* __restrict wPlus, const float* __restrict wMinus,
                     const float* __restrict up, const float* __restrict um, float* __restrict acc) {
   for (int i = 0; i < n; ++i) acc[i] += wPlus[i] * up[i] + wMinus[i] * um[i];

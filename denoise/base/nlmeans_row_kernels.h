@@ -9,6 +9,8 @@
 // p + δ / p − δ (pointers into zero-padded planes). "num" variances are α V, "den" variances
 // k² Vn, as in nlmeans_weights.h.
 
+#include <cstddef>
+
 namespace chorus::rows {
 
 // out += min(clamp, [(f − fq)² − (vn + min(vn, vnq))] / (den + denq + ε)) for two denominator
@@ -45,6 +47,14 @@ void addFeatureDistances(int n, const float* f, const float* fp, const float* fm
                          const float* vnp, const float* vnm, const float* den, const float* denp,
                          const float* denm, float neighbourShare, float* plus, float* minus,
                          float* sym);
+
+// dst[i] = Σ_{j = −r … r} src[i + j] (src readable from −r to n + r).
+void horizontalBoxSum(int n, const float* src, int r, float* dst);
+
+// dst[i] = Σ_{j = 0 … count − 1} src[i + j · stride] · scaleY · scaleX[i]: a column of row sums
+// turned into a box mean.
+void verticalBoxMean(int n, const float* src, size_t stride, int count, float scaleY,
+                     const float* scaleX, float* dst);
 
 // dst = max(dst, scale · src).
 void maxScaled(int n, float scale, const float* src, float* dst);

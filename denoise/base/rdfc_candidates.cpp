@@ -237,30 +237,17 @@ void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, Tile
         m.invCountX[size_t(i)] = nx > 0 ? 1.0f / float(nx) : 0.0f;
       }
       // Horizontal sums for the rows [tile.y0 − f, tile.y1 + f), tile columns.
-      for (int y = tile.y0 - f; y < tile.y1 + f; ++y) {
-        const float* src = e.data() + size_t(y - ey0) * size_t(ew) + size_t(tile.x0 - ex0);
-        float* dst = m.rowSums.data() + size_t(y - tile.y0 + f) * size_t(tw);
-        for (int i = 0; i < tw; ++i) dst[i] = src[i - f];
-        for (int j = -f + 1; j <= f; ++j)
-          for (int i = 0; i < tw; ++i) dst[i] += src[i + j];
-      }
-      float* dist = m.dist[s][kind].data();
-      float* inv = m.invCount[s][kind].data();
+      for (int y = tile.y0 - f; y < tile.y1 + f; ++y)
+        rows::horizontalBoxSum(tw, e.data() + size_t(y - ey0) * size_t(ew) + size_t(tile.x0 - ex0),
+                               f, m.rowSums.data() + size_t(y - tile.y0 + f) * size_t(tw));
       for (int y = tile.y0; y < tile.y1; ++y) {
-        float* drow = dist + size_t(y - tile.y0) * size_t(tw);
-        float* irow = inv + size_t(y - tile.y0) * size_t(tw);
-        const float* first = m.rowSums.data() + size_t(y - tile.y0) * size_t(tw);
-        for (int i = 0; i < tw; ++i) drow[i] = first[i];
-        for (int j = 1; j <= 2 * f; ++j) {
-          const float* src = m.rowSums.data() + size_t(y - tile.y0 + j) * size_t(tw);
-          for (int i = 0; i < tw; ++i) drow[i] += src[i];
-        }
+        const size_t row = size_t(y - tile.y0) * size_t(tw);
         const int ny = boxOverlap(y, f, loY[kind], hiY[kind]);
         const float invY = ny > 0 ? 1.0f / float(ny) : 0.0f;
-        for (int i = 0; i < tw; ++i) {
-          irow[i] = invY * m.invCountX[size_t(i)];
-          drow[i] *= irow[i];
-        }
+        float* inv = m.invCount[s][kind].data() + row;
+        for (int i = 0; i < tw; ++i) inv[i] = invY * m.invCountX[size_t(i)];
+        rows::verticalBoxMean(tw, m.rowSums.data() + row, size_t(tw), 2 * f + 1, invY,
+                              m.invCountX.data(), m.dist[s][kind].data() + row);
       }
     }
   }

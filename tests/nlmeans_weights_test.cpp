@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <map>
@@ -368,6 +369,44 @@ TEST(NlMeansWeights, MissingStatisticsMatchNothing) {
   const Image out = nlMeans(data, ref.terms[0], ref.params);
   EXPECT_FLOAT_EQ(out.at(12, 8, 0), data.at(12, 8, 0));
   for (float v : out.values()) EXPECT_TRUE(std::isfinite(v));
+}
+
+TEST(NlMeansWeights, FusedSingleTermPathIsBitIdenticalToTheGeneralPath) {
+  // A second term whose weight is exactly 1 everywhere (zero guide, zero variance: d = 0)
+  // changes nothing but forces the general path.
+  const Image guide = smoothRandom(37, 29, 3, 20, 0.0f, 1.0f);
+  Image variance = test::randomImage(37, 29, 3, 21, 0.001f, 0.02f);
+  variance(5, 7, 1) = std::numeric_limits<float>::quiet_NaN();
+  const Image zero(37, 29, 1, 0.0f);
+  const NlMeansTerm neutral{.guide = &zero, .variance = &zero, .f = 0};
+  for (ChannelWeights mode : {ChannelWeights::PerChannel, ChannelWeights::MinOverChannels,
+                              ChannelWeights::AverageDistance}) {
+    for (int f : {0, 1, 3}) {
+      const NlMeansTerm term{.guide = &guide,
+                             .variance = &variance,
+                             .f = f,
+                             .k = 0.6f,
+                             .s = 2.0f,
+                             .epsilon = 1e-7f,
+                             .channels = mode};
+      const NlMeansParams params{.r = 4, .weightThreshold = 0.01f, .minCenterWeight = 1e-4f};
+      const NlMeansWeights fused(term, params);
+      const NlMeansTerm both[] = {term, neutral};
+      const NlMeansWeights general(both, params);
+      const PixelRect tile{3, 2, 25, 29};
+      const size_t n = size_t(tile.area()) * size_t(fused.weightChannels());
+      std::vector<float> p1(n), m1(n), p2(n), m2(n);
+      NlMeansScratch s1, s2;
+      fused.forEachOffsetPair([&](int dx, int dy) {
+        fused.offsetPair(tile, dx, dy, s1, p1.data(), m1.data());
+        general.offsetPair(tile, dx, dy, s2, p2.data(), m2.data());
+        ASSERT_EQ(0, std::memcmp(p1.data(), p2.data(), n * sizeof(float)))
+            << "f " << f << " δ (" << dx << "," << dy << ")";
+        ASSERT_EQ(0, std::memcmp(m1.data(), m2.data(), n * sizeof(float)))
+            << "f " << f << " δ (" << -dx << "," << -dy << ")";
+      });
+    }
+  }
 }
 
 // ---- Statistical properties -----------------------------------------------------------------

@@ -8,12 +8,8 @@
 namespace chorus {
 namespace {
 
-// Radii up to this sum their taps directly; beyond, running sums are cheaper.
-constexpr int kMaxDirectRadius = 4;  // also the largest kernel instantiated below
-
-int roundUp4(int n) {
-  return (n + 3) / 4 * 4;
-}
+using box_kernels::kMaxDirectRadius;
+using box_kernels::roundUp4;
 
 // 1 / (true count) of the clipped box along an axis of length n, padded to a multiple of 4.
 void inverseCounts(int n, int r, std::vector<float>& inv) {
@@ -34,36 +30,36 @@ void boxRowDirect(const float* padded, float* out, int n, const float* invCount)
   }
 }
 
-// out[x] = inv · Σ_{j < N} rows[j · stride + x] for x < vectorEnd (a multiple of 4).
+// out[x] = inv · Σ_{j < N} rows[j][x] for x < vectorEnd (a multiple of 4), rows in order.
 template <int N>
-void columnSum(const float* rows, size_t stride, float inv, float* out, int vectorEnd) {
+void columnSum(const float* const* rows, float inv, float* out, int vectorEnd) {
   for (int x = 0; x < vectorEnd; x += 4) {
-    Quad acc = loadQuad(rows + x);
-    for (int j = 1; j < N; ++j) acc += loadQuad(rows + size_t(j) * stride + size_t(x));
+    Quad acc = loadQuad(rows[0] + x);
+    for (int j = 1; j < N; ++j) acc += loadQuad(rows[j] + x);
     storeQuad(out + x, acc * splatQuad(inv));
   }
 }
 
-void columnSumAny(const float* rows, size_t stride, int n, float inv, float* out, int vectorEnd) {
+void columnSumAny(const float* const* rows, int n, float inv, float* out, int vectorEnd) {
   switch (n) {
     case 1:
-      return columnSum<1>(rows, stride, inv, out, vectorEnd);
+      return columnSum<1>(rows, inv, out, vectorEnd);
     case 2:
-      return columnSum<2>(rows, stride, inv, out, vectorEnd);
+      return columnSum<2>(rows, inv, out, vectorEnd);
     case 3:
-      return columnSum<3>(rows, stride, inv, out, vectorEnd);
+      return columnSum<3>(rows, inv, out, vectorEnd);
     case 4:
-      return columnSum<4>(rows, stride, inv, out, vectorEnd);
+      return columnSum<4>(rows, inv, out, vectorEnd);
     case 5:
-      return columnSum<5>(rows, stride, inv, out, vectorEnd);
+      return columnSum<5>(rows, inv, out, vectorEnd);
     case 6:
-      return columnSum<6>(rows, stride, inv, out, vectorEnd);
+      return columnSum<6>(rows, inv, out, vectorEnd);
     case 7:
-      return columnSum<7>(rows, stride, inv, out, vectorEnd);
+      return columnSum<7>(rows, inv, out, vectorEnd);
     case 8:
-      return columnSum<8>(rows, stride, inv, out, vectorEnd);
+      return columnSum<8>(rows, inv, out, vectorEnd);
     default:
-      return columnSum<9>(rows, stride, inv, out, vectorEnd);
+      return columnSum<9>(rows, inv, out, vectorEnd);
   }
 }
 
@@ -104,21 +100,16 @@ void boxFilterDirect(const float* src, int width, int height, int radius, const 
   for (int y = rowBegin; y < rowEnd; ++y) {
     const float* row = src + size_t(y) * size_t(width);
     std::copy(row + copyBegin, row + copyEnd, padded + (copyBegin - readBegin));
-    boxRowAny(padded, tmp.data() + size_t(y - rowBegin) * stride, cw, radius, invX.data());
+    box_kernels::rowSums(padded, tmp.data() + size_t(y - rowBegin) * stride, cw, radius,
+                         invX.data());
   }
   // Column pass: each output row is the mean of the clipped run of row means.
-  const int vectorEnd = cw / 4 * 4;
+  const float* rows[2 * kMaxDirectRadius + 1];
   for (int y = crop.y0; y < crop.y1; ++y) {
     const int a = std::max(0, y - radius), b = std::min(height - 1, y + radius);
-    const float inv = invY[size_t(y)];
-    float* out = dst + size_t(y - crop.y0) * size_t(cw);
-    const float* first = tmp.data() + size_t(a - rowBegin) * stride;
-    columnSumAny(first, stride, b - a + 1, inv, out, vectorEnd);
-    for (int x = vectorEnd; x < cw; ++x) {
-      float acc = first[x];
-      for (int j = 1; j <= b - a; ++j) acc += first[size_t(j) * stride + size_t(x)];
-      out[x] = acc * inv;
-    }
+    for (int j = a; j <= b; ++j) rows[j - a] = tmp.data() + size_t(j - rowBegin) * stride;
+    box_kernels::columnSums(rows, b - a + 1, invY[size_t(y)],
+                            dst + size_t(y - crop.y0) * size_t(cw), cw);
   }
 }
 
@@ -154,6 +145,24 @@ void boxFilterRunning(const float* src, float* dst, int width, int height, int r
 }
 
 }  // namespace
+
+namespace box_kernels {
+
+void rowSums(const float* padded, float* out, int n, int r, const float* invCount) {
+  boxRowAny(padded, out, n, r, invCount);
+}
+
+void columnSums(const float* const* rows, int count, float inv, float* out, int n) {
+  const int vectorEnd = n / 4 * 4;
+  columnSumAny(rows, count, inv, out, vectorEnd);
+  for (int x = vectorEnd; x < n; ++x) {
+    float acc = rows[0][x];
+    for (int j = 1; j < count; ++j) acc += rows[j][x];
+    out[x] = acc * inv;
+  }
+}
+
+}  // namespace box_kernels
 
 void boxFilterCrop(const float* src, int width, int height, int radius, const PixelRect& crop,
                    float* dst, std::vector<float>& tmp) {

@@ -22,6 +22,22 @@ void boxFilterPlane(const float* src, float* dst, int width, int height, int rad
 void boxFilterCrop(const float* src, int width, int height, int radius, const PixelRect& crop,
                    float* dst, std::vector<float>& tmp);
 
+// The direct-tap kernels, shared with the fused NL-means weights (nlmeans_weights.cpp), which
+// must sum in the same order to give bit-identical results.
+namespace box_kernels {
+// Radii up to this sum their taps directly; beyond, running sums are cheaper.
+inline constexpr int kMaxDirectRadius = 4;
+inline int roundUp4(int n) {
+  return (n + 3) / 4 * 4;
+}
+// out[x] = invCount[x] · Σ_{j=0}^{2r} padded[x + j] for x < n, taps in ascending order; padded
+// holds the row between r zeros; out and invCount have room for roundUp4(n) values.
+void rowSums(const float* padded, float* out, int n, int r, const float* invCount);
+// out[x] = inv · Σ_{j < count} rows[j][x] for x < n, rows in order (count ≤ 2 kMaxDirectRadius +
+// 1).
+void columnSums(const float* const* rows, int count, float inv, float* out, int n);
+}  // namespace box_kernels
+
 // Every channel of `image` box-filtered with the given radius.
 Image boxFilter(const Image& image, int radius);
 

@@ -66,6 +66,8 @@ NlMeansWeights::NlMeansWeights(std::span<const NlMeansTerm> terms, const NlMeans
     terms_.push_back(std::move(t));
   }
   weightChannels_ = perChannel == 0 ? 1 : perChannel;
+  fused_ = terms_.size() == 1 && !anySymmetric_ && params_.weightBoxRadius == 0 &&
+           terms_[0].f <= box_kernels::kMaxDirectRadius;
 }
 
 int NlMeansWeights::distanceChannels(int term) const {
@@ -73,48 +75,51 @@ int NlMeansWeights::distanceChannels(int term) const {
   return t.channels == ChannelWeights::AverageDistance ? 1 : t.guide.channels();
 }
 
+void NlMeansWeights::distanceRow(const PreparedTerm& t, int c, int y, int x0, int w, int dx, int dy,
+                                 bool accumulate, bool symmetric, float* out) {
+  const float eps = t.epsilon, clamp = t.distanceClamp;
+  const bool centerOnly = t.centerOnlyDenominator;
+  float* __restrict o = out;
+  const float* __restrict gp = t.guide.row(c, y) + x0;
+  const float* __restrict np = t.varianceNum.row(c, y) + x0;
+  const float* __restrict dp = t.varianceDen.row(c, y) + x0;
+  const float* __restrict g1 = t.guide.row(c, y + dy) + x0 + dx;
+  const float* __restrict n1 = t.varianceNum.row(c, y + dy) + x0 + dx;
+  const float* __restrict d1 = t.varianceDen.row(c, y + dy) + x0 + dx;
+  if (!symmetric) {
+    for (int x = 0; x < w; ++x) {
+      const float diff = gp[x] - g1[x];
+      const float num = diff * diff - (np[x] + std::min(np[x], n1[x]));
+      const float den = (centerOnly ? dp[x] + dp[x] : dp[x] + d1[x]) + eps;
+      float d = num / den;
+      d = d <= clamp ? d : clamp;  // also maps NaN (missing statistics) to the clamp
+      o[x] = accumulate ? o[x] + d : d;
+    }
+    return;
+  }
+  const float* __restrict g2 = t.guide.row(c, y - dy) + x0 - dx;
+  const float* __restrict n2 = t.varianceNum.row(c, y - dy) + x0 - dx;
+  const float* __restrict d2 = t.varianceDen.row(c, y - dy) + x0 - dx;
+  for (int x = 0; x < w; ++x) {
+    // Distance from p to the mean of its two neighbours; its variance is (V1 + V2) / 4.
+    const float diff = gp[x] - 0.5f * (g1[x] + g2[x]);
+    const float num =
+        diff * diff - (np[x] + 0.25f * (std::min(np[x], n1[x]) + std::min(np[x], n2[x])));
+    const float den = (centerOnly ? dp[x] + dp[x] : dp[x] + 0.25f * (d1[x] + d2[x])) + eps;
+    float d = num / den;
+    d = d <= clamp ? d : clamp;
+    o[x] = accumulate ? o[x] + d : d;
+  }
+}
+
 void NlMeansWeights::pixelDistances(const PreparedTerm& t, const PixelRect& e, int dx, int dy,
                                     bool average, bool symmetric, float* out) const {
   const int w = e.width(), channels = t.guide.channels();
   const size_t area = size_t(e.area());
-  const float eps = t.epsilon, clamp = t.distanceClamp;
-  const bool centerOnly = t.centerOnlyDenominator;
-  for (int c = 0; c < channels; ++c) {
-    for (int y = e.y0; y < e.y1; ++y) {
-      float* __restrict o = out + (average ? 0 : size_t(c) * area) + size_t(y - e.y0) * size_t(w);
-      const float* __restrict gp = t.guide.row(c, y) + e.x0;
-      const float* __restrict np = t.varianceNum.row(c, y) + e.x0;
-      const float* __restrict dp = t.varianceDen.row(c, y) + e.x0;
-      const float* __restrict g1 = t.guide.row(c, y + dy) + e.x0 + dx;
-      const float* __restrict n1 = t.varianceNum.row(c, y + dy) + e.x0 + dx;
-      const float* __restrict d1 = t.varianceDen.row(c, y + dy) + e.x0 + dx;
-      const bool accumulate = average && c > 0;
-      if (!symmetric) {
-        for (int x = 0; x < w; ++x) {
-          const float diff = gp[x] - g1[x];
-          const float num = diff * diff - (np[x] + std::min(np[x], n1[x]));
-          const float den = (centerOnly ? dp[x] + dp[x] : dp[x] + d1[x]) + eps;
-          float d = num / den;
-          d = d <= clamp ? d : clamp;  // also maps NaN (missing statistics) to the clamp
-          o[x] = accumulate ? o[x] + d : d;
-        }
-      } else {
-        const float* __restrict g2 = t.guide.row(c, y - dy) + e.x0 - dx;
-        const float* __restrict n2 = t.varianceNum.row(c, y - dy) + e.x0 - dx;
-        const float* __restrict d2 = t.varianceDen.row(c, y - dy) + e.x0 - dx;
-        for (int x = 0; x < w; ++x) {
-          // Distance from p to the mean of its two neighbours; its variance is (V1 + V2) / 4.
-          const float diff = gp[x] - 0.5f * (g1[x] + g2[x]);
-          const float num =
-              diff * diff - (np[x] + 0.25f * (std::min(np[x], n1[x]) + std::min(np[x], n2[x])));
-          const float den = (centerOnly ? dp[x] + dp[x] : dp[x] + 0.25f * (d1[x] + d2[x])) + eps;
-          float d = num / den;
-          d = d <= clamp ? d : clamp;
-          o[x] = accumulate ? o[x] + d : d;
-        }
-      }
-    }
-  }
+  for (int c = 0; c < channels; ++c)
+    for (int y = e.y0; y < e.y1; ++y)
+      distanceRow(t, c, y, e.x0, w, dx, dy, average && c > 0, symmetric,
+                  out + (average ? 0 : size_t(c) * area) + size_t(y - e.y0) * size_t(w));
   if (average && channels > 1) {
     const float inv = 1.0f / float(channels);
     for (size_t i = 0; i < area; ++i) out[i] *= inv;
@@ -241,8 +246,111 @@ void NlMeansWeights::finishWeights(float* weights, const PixelRect& region, cons
   }
 }
 
+void NlMeansWeights::fusedOffsetWeights(const PreparedTerm& t, const PixelRect& tile, int dx,
+                                        int dy, NlMeansScratch& scratch, float* out) const {
+  const size_t tArea = size_t(tile.area());
+  std::fill(out, out + tArea * size_t(weightChannels_), 0.0f);
+  const PixelRect valid =
+      PixelRect::image(width_, height_).intersect(neighbourInside(width_, height_, dx, dy));
+  const PixelRect r = tile.intersect(valid);
+  if (r.empty()) return;
+  const PixelRect e = r.grown(t.f).intersect(valid);
+  const bool average = t.channels == ChannelWeights::AverageDistance;
+  const int channels = t.guide.channels(), planes = average ? 1 : channels, f = t.f;
+  const int ring = 2 * f + 1, rw = r.width(), ew = e.width();
+  const size_t stride = size_t(box_kernels::roundUp4(rw));
+  const size_t paddedSize = size_t(box_kernels::roundUp4(rw + 2 * f) + 4);
+
+  // Scratch: one row of pixel distances, a zero-padded row, the row means of the last 2f + 1
+  // rows (a ring), one row of patch distances and the inverse counts of both axes.
+  std::vector<float>& buf = scratch.pixelDistance;
+  buf.resize(size_t(planes) * size_t(ew) + paddedSize +
+             (size_t(ring) + 1) * size_t(planes) * stride + stride + size_t(e.height()));
+  float* rowDistance = buf.data();
+  float* padded = rowDistance + size_t(planes) * size_t(ew);
+  float* ringRows = padded + paddedSize;
+  float* patch = ringRows + size_t(ring) * size_t(planes) * stride;
+  float* invX = patch + size_t(planes) * stride;
+  float* invY = invX + stride;
+  std::fill(padded, padded + paddedSize, 0.0f);
+  for (int x = 0; x < rw; ++x) {
+    const int px = r.x0 - e.x0 + x;
+    invX[x] = 1.0f / float(std::min(ew - 1, px + f) - std::max(0, px - f) + 1);
+  }
+  for (int x = rw; x < int(stride); ++x) invX[x] = 0.0f;
+  for (int y = 0; y < e.height(); ++y)
+    invY[y] = 1.0f / float(std::min(e.height() - 1, y + f) - std::max(0, y - f) + 1);
+  auto ringRow = [&](int y, int c) {
+    return ringRows + (size_t((y - e.y0) % ring) * size_t(planes) + size_t(c)) * stride;
+  };
+  const int copyBegin = std::max(e.x0, r.x0 - f), copyEnd = std::min(e.x1, r.x1 + f);
+
+  // One output row of weights from the ring rows [yo − f, yo + f] ∩ e.
+  const float threshold = params_.weightThreshold;
+  auto emit = [&](int yo) {
+    const int a = std::max(e.y0, yo - f), b = std::min(e.y1 - 1, yo + f);
+    const float* rows[2 * box_kernels::kMaxDirectRadius + 1];
+    for (int c = 0; c < planes; ++c) {
+      float* dst = patch + size_t(c) * stride;
+      if (f == 0) {
+        std::copy(ringRow(yo, c), ringRow(yo, c) + rw, dst);
+        continue;
+      }
+      for (int j = a; j <= b; ++j) rows[j - a] = ringRow(j, c);
+      box_kernels::columnSums(rows, b - a + 1, invY[yo - e.y0], dst, rw);
+    }
+    float* row = out + size_t(yo - tile.y0) * size_t(tile.width()) + size_t(r.x0 - tile.x0);
+    auto finish = [&](float* w, int n) {
+      expNonPositiveInPlace(w, size_t(n));
+      for (int x = 0; x < n; ++x) w[x] = w[x] < threshold ? 0.0f : w[x];
+    };
+    if (t.channels == ChannelWeights::PerChannel) {
+      for (int c = 0; c < planes; ++c) {
+        float* w = row + size_t(c) * tArea;
+        const float* d = patch + size_t(c) * stride;
+        for (int x = 0; x < rw; ++x) w[x] = -std::min(std::max(d[x], 0.0f), kMaxExpArgument);
+        finish(w, rw);
+      }
+      return;
+    }
+    float* m = patch;  // MinOverChannels: max_c D_c, in channel order
+    for (int c = 1; c < planes; ++c)
+      for (int x = 0; x < rw; ++x) m[x] = std::max(m[x], patch[size_t(c) * stride + size_t(x)]);
+    for (int x = 0; x < rw; ++x) row[x] = -std::min(std::max(m[x], 0.0f), kMaxExpArgument);
+    finish(row, rw);
+  };
+
+  for (int y = e.y0; y < e.y1; ++y) {
+    for (int c = 0; c < channels; ++c)
+      distanceRow(t, c, y, e.x0, ew, dx, dy, average && c > 0, false,
+                  rowDistance + (average ? 0 : size_t(c) * size_t(ew)));
+    if (average && channels > 1) {
+      const float inv = 1.0f / float(channels);
+      for (int x = 0; x < ew; ++x) rowDistance[x] *= inv;
+    }
+    for (int c = 0; c < planes; ++c) {
+      const float* src = rowDistance + size_t(c) * size_t(ew);
+      if (f == 0) {
+        std::copy(src + (r.x0 - e.x0), src + (r.x0 - e.x0) + rw, ringRow(y, c));
+        continue;
+      }
+      std::copy(src + (copyBegin - e.x0), src + (copyEnd - e.x0),
+                padded + (copyBegin - (r.x0 - f)));
+      box_kernels::rowSums(padded, ringRow(y, c), rw, f, invX);
+    }
+    const int yo = y - f;
+    if (yo >= r.y0 && yo < r.y1) emit(yo);
+  }
+  for (int yo = std::max(r.y0, e.y1 - f); yo < r.y1; ++yo) emit(yo);
+}
+
 void NlMeansWeights::offsetPair(const PixelRect& tile, int dx, int dy, NlMeansScratch& scratch,
                                 float* plus, float* minus) const {
+  if (fused_) {
+    fusedOffsetWeights(terms_[0], tile, dx, dy, scratch, plus);
+    fusedOffsetWeights(terms_[0], tile, -dx, -dy, scratch, minus);
+    return;
+  }
   const PixelRect grown =
       tile.grown(params_.weightBoxRadius).intersect(PixelRect::image(width_, height_));
   const PixelRect rp = grown.intersect(neighbourInside(width_, height_, dx, dy));

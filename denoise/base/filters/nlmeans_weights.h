@@ -147,8 +147,12 @@ class NlMeansWeights {
     PlanarImage varianceDen;    // k² s Vd
   };
 
+  // Per-pixel distances d_c of one row segment [x0, x0 + w) × {y} (stored, or added to `out`
+  // when `accumulate`). With `symmetric`, the distance to the mean of p + δ and p − δ.
+  static void distanceRow(const PreparedTerm& t, int c, int y, int x0, int w, int dx, int dy,
+                          bool accumulate, bool symmetric, float* out);
   // Per-pixel distances of term t over rect e for offset (dx, dy): one plane per channel, or
-  // their mean when `average`. With `symmetric`, the distance to the mean of p + δ and p − δ.
+  // their mean when `average`.
   void pixelDistances(const PreparedTerm& t, const PixelRect& e, int dx, int dy, bool average,
                       bool symmetric, float* out) const;
   // Patch distances over `region` (see patchDistance), symmetric variant included.
@@ -159,6 +163,11 @@ class NlMeansWeights {
   // The combined weights of every term over `region` for one offset (no refinement).
   void combinedWeights(const PixelRect& region, int dx, int dy, NlMeansScratch& scratch,
                        float* out) const;
+  // The weights of one offset for one term without refinement or patchwise box, all stages in
+  // one sweep over the rows (the row means of the last 2f + 1 rows kept in a ring): the same
+  // float operations in the same order as the general path, so bit-identical to it.
+  void fusedOffsetWeights(const PreparedTerm& t, const PixelRect& tile, int dx, int dy,
+                          NlMeansScratch& scratch, float* out) const;
   // Patchwise box filter, threshold and copy of the tile part of weights over `region`.
   void finishWeights(float* weights, const PixelRect& region, const PixelRect& tile,
                      NlMeansScratch& scratch, float* out) const;
@@ -167,6 +176,7 @@ class NlMeansWeights {
   NlMeansParams params_;
   std::vector<PreparedTerm> terms_;
   bool anySymmetric_ = false;
+  bool fused_ = false;  // fusedOffsetWeights applies
 };
 
 }  // namespace chorus

@@ -1,0 +1,126 @@
+// bench_nfor: speed and quality of NFOR and dual-buffer NL-means on the Tungsten peer data
+// (../shared/peers/tungsten-nfor).
+//   speed:   seconds per megapixel on --threads threads (default 2), on one case's input
+//            buffers tiled to --size × --size (default 1024 × 1024);
+//   quality: relMSE against the reference for the six cases, next to Tungsten's own NFOR
+//            output, and how close our NFOR is to Tungsten's.
+#include <tbb/global_control.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "denoise/base/dual_buffer_nlm.h"
+#include "denoise/base/nfor.h"
+#include "denoise/buffers/tungsten_dir.h"
+#include "denoise/image/exr_io.h"
+#include "denoise/metrics/metrics.h"
+#include "denoise/util/error.h"
+
+namespace chorus {
+namespace {
+
+// `image` repeated to cover size × size (mirrored on odd tiles so that seams stay continuous).
+Image tiled(const Image& image, int size) {
+  Image out(size, size, image.channels());
+  const int w = image.width(), h = image.height();
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const int tx = x / w, ty = y / h;
+      const int sx = tx % 2 == 0 ? x % w : w - 1 - x % w;
+      const int sy = ty % 2 == 0 ? y % h : h - 1 - y % h;
+      for (int c = 0; c < image.channels(); ++c) out(x, y, c) = image(sx, sy, c);
+    }
+  return out;
+}
+
+SubBuffer tiled(const SubBuffer& b, int size) {
+  SubBuffer out;
+  for (Quantity q : kAllQuantities) {
+    out.get(q).mean = tiled(b.get(q).mean, size);
+    out.get(q).varianceOfMean = tiled(b.get(q).varianceOfMean, size);
+  }
+  out.sampleCount = tiled(b.sampleCount, size);
+  return out;
+}
+
+DenoiseInput tiled(const DenoiseInput& in, int size) {
+  DenoiseInput out;
+  out.whole = tiled(in.whole, size);
+  out.halves =
+      std::array<SubBuffer, 2>{tiled(in.halves->at(0), size), tiled(in.halves->at(1), size)};
+  return out;
+}
+
+template <typename Fn>
+double seconds(Fn&& fn) {
+  const auto t0 = std::chrono::steady_clock::now();
+  fn();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+int run(int argc, char** argv) {
+  CLI::App app("Speed (s/Mpx) and quality (relMSE) of nfor and nlm on the Tungsten peer data");
+  std::string shared = "../shared";
+  int threads = 2, size = 1024;
+  std::string speedCase = "room/spp4";
+  bool skipSpeed = false, skipQuality = false;
+  app.add_option("--shared", shared, "the shared data directory");
+  app.add_option("--threads", threads, "TBB threads");
+  app.add_option("--size", size, "side of the tiled image for the speed measurement");
+  app.add_option("--case", speedCase, "the peer case tiled for the speed measurement");
+  app.add_flag("--skip-speed", skipSpeed);
+  app.add_flag("--skip-quality", skipQuality);
+  CLI11_PARSE(app, argc, argv);
+  const std::filesystem::path root = std::filesystem::path(shared) / "peers/tungsten-nfor";
+  if (!std::filesystem::is_directory(root)) throw fileError(root, "no such directory");
+  tbb::global_control control(tbb::global_control::max_allowed_parallelism, size_t(threads));
+
+  if (!skipSpeed) {
+    const DenoiseInput input = tiled(readTungstenDirectory(root / speedCase), size);
+    const double mpx = double(size) * size / 1e6;
+    const double nfor = seconds([&] { NforDenoiser().run(input); });
+    const double nlm = seconds([&] { DualBufferNlMeans().run(input); });
+    std::printf("speed: %s tiled to %dx%d, %d threads\n", speedCase.c_str(), size, size, threads);
+    std::printf("  %-6s %8.2f s  %8.2f s/Mpx\n", "nfor", nfor, nfor / mpx);
+    std::printf("  %-6s %8.2f s  %8.2f s/Mpx\n", "nlm", nlm, nlm / mpx);
+  }
+  if (!skipQuality) {
+    std::printf(
+        "quality (relMSE against reference.exr; frac = relMSE(ours, nfor.exr) / "
+        "relMSE(noisy, nfor.exr))\n");
+    std::printf("  %-7s %-6s %10s %10s %10s %7s %8s %10s %8s\n", "scene", "spp", "noisy",
+                "tungsten", "nfor", "ratio", "frac", "nlm", "nfor s");
+    for (const char* scene : {"room", "glossy"}) {
+      const Image reference = readExrLayer(root / scene / "reference.exr");
+      for (const char* spp : {"spp4", "spp16", "spp64"}) {
+        const auto dir = root / scene / spp;
+        const DenoiseInput input = readTungstenDirectory(dir);
+        const Image tungsten = readExrLayer(dir / "nfor.exr");
+        Image ours;
+        const double time = seconds([&] { ours = NforDenoiser().run(input); });
+        const Image nlm = DualBufferNlMeans().run(input);
+        const double oursRef = relMse(ours, reference), tungRef = relMse(tungsten, reference);
+        std::printf("  %-7s %-6s %10.6f %10.6f %10.6f %7.4f %8.4f %10.6f %8.2f\n", scene, spp,
+                    relMse(input.whole.color.mean, reference), tungRef, oursRef, oursRef / tungRef,
+                    relMse(ours, tungsten) / relMse(input.whole.color.mean, tungsten),
+                    relMse(nlm, reference), time);
+      }
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace chorus
+
+int main(int argc, char** argv) {
+  try {
+    return chorus::run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_nfor: %s\n", e.what());
+    return 2;
+  }
+}

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <string>
 
@@ -54,11 +55,28 @@ DenoiseInput tiled(const DenoiseInput& in, int size) {
   return out;
 }
 
+double processCpuSeconds() {
+  timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+struct Timing {
+  double wall = 0, cpu = 0;  // seconds; cpu summed over all threads
+};
+
 template <typename Fn>
-double seconds(Fn&& fn) {
+Timing timed(Fn&& fn) {
+  const double cpu0 = processCpuSeconds();
   const auto t0 = std::chrono::steady_clock::now();
   fn();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return {std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+          processCpuSeconds() - cpu0};
+}
+
+template <typename Fn>
+double seconds(Fn&& fn) {
+  return timed(fn).wall;
 }
 
 int run(int argc, char** argv) {
@@ -81,11 +99,15 @@ int run(int argc, char** argv) {
   if (!skipSpeed) {
     const DenoiseInput input = tiled(readTungstenDirectory(root / speedCase), size);
     const double mpx = double(size) * size / 1e6;
-    const double nfor = seconds([&] { NforDenoiser().run(input); });
-    const double nlm = seconds([&] { DualBufferNlMeans().run(input); });
+    const Timing nfor = timed([&] { NforDenoiser().run(input); });
+    const Timing nlm = timed([&] { DualBufferNlMeans().run(input); });
+    // cpu / threads is what the wall clock would be on otherwise idle cores with perfect
+    // scaling: a load-independent figure next to the wall clock.
     std::printf("speed: %s tiled to %dx%d, %d threads\n", speedCase.c_str(), size, size, threads);
-    std::printf("  %-6s %8.2f s  %8.2f s/Mpx\n", "nfor", nfor, nfor / mpx);
-    std::printf("  %-6s %8.2f s  %8.2f s/Mpx\n", "nlm", nlm, nlm / mpx);
+    std::printf("  %-6s %9s %9s %14s\n", "", "wall s/Mpx", "cpu s/Mpx", "cpu/threads");
+    for (const auto& [name, t] : {std::pair{"nfor", nfor}, std::pair{"nlm", nlm}})
+      std::printf("  %-6s %9.2f %9.2f %14.2f\n", name, t.wall / mpx, t.cpu / mpx,
+                  t.cpu / mpx / threads);
   }
   if (!skipQuality) {
     std::printf(

@@ -28,6 +28,8 @@ void validate(const RenderOptions& o) {
   if (o.width < 0 || o.height < 0) throw Error("--width and --height must be positive");
   if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");
   if (o.threads < 0) throw Error("--threads must be positive (0 = all cores)");
+  if (o.camera < 0) throw Error("--camera must be 0 or more");
+  if (o.rouletteStartDepth < 0) throw Error("rouletteStartDepth must be 0 or more");
 }
 
 }  // namespace
@@ -38,9 +40,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
   const auto start = std::chrono::steady_clock::now();
 
   // The camera's own aspect decides a missing dimension; the framing camera adapts to the image.
-  const CameraDesc* fileCamera = options.camera < int(scene.data().cameras.size())
-                                     ? &scene.data().cameras[size_t(std::max(0, options.camera))]
-                                     : nullptr;
+  const std::vector<CameraDesc>& cameras = scene.data().cameras;
+  const CameraDesc* fileCamera =
+      size_t(options.camera) < cameras.size() ? &cameras[size_t(options.camera)] : nullptr;
   const Resolution resolution =
       chooseResolution(fileCamera ? *fileCamera : CameraDesc{}, options.width, options.height);
   const Camera camera(

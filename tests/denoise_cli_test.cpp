@@ -99,7 +99,7 @@ TEST(DenoiseCli, OptionsReachTheLibrary) {
   const fs::path out = f.dir / "out";
   const auto r = runChorus({"denoise", f.input.string(), "--methods", "box1,nlm", "--mse",
                             "per-channel", "--window", "0", "--weight-filter", "none", "--solver",
-                            "pairwise", "--seed", "5", "--relative", "--out", out.string()});
+                            "pairwise", "--solver-seed", "5", "--relative", "--out", out.string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   CombineOptions o;
   o.mse.form = MseForm::PerChannel;

@@ -7,7 +7,6 @@
 // Writes DIR/<combiner>.exr/.png, DIR/weights.exr, DIR/<method>.exr and DIR/stats.json.
 #include <nlohmann/json.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -25,7 +24,10 @@
 #include "denoise/metrics/metrics.h"
 #include "denoise/util/atomic_file.h"
 #include "denoise/util/error.h"
+#include "denoise/util/stopwatch.h"
 #include "tools/chorus/command.h"
+#include "tools/chorus/ensemble_flags.h"
+#include "tools/chorus/ensemble_outputs.h"
 
 namespace chorus::cli {
 namespace {
@@ -35,26 +37,9 @@ using Json = nlohmann::ordered_json;
 
 struct DenoiseArgs {
   std::string input, methods, out;
-  std::string combine = "ensemble", solver = "active-set", weightFilter = "bilateral";
-  std::string mseForm = "summed", reference;
-  int window = MseOptions{}.windowRadius;
-  bool relative = MseOptions{}.relative;
-  uint64_t seed = 1;
+  std::string combine = "ensemble", reference;
+  EnsembleFlags ensemble;
 };
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-// A method spec as a file and layer name: "nlm:k=0.4" → "nlm_k=0.4".
-std::string labelOf(const std::string& spec) {
-  std::string label = spec;
-  for (char& c : label)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' ||
-          c == '=' || c == '+'))
-      c = '_';
-  return label;
-}
 
 // What the combination step needs, from any of the three input forms.
 struct LoadedInput {
@@ -66,9 +51,7 @@ struct LoadedInput {
 
 LoadedInput runBuiltins(const EnsembleSources& sources, const std::vector<std::string>& specs,
                         const std::string& kind, const fs::path& input) {
-  std::vector<EnsembleMember> members;
-  for (const std::string& spec : specs)
-    members.push_back({labelOf(spec), std::shared_ptr<const BaseDenoiser>(createDenoiser(spec))});
+  const std::vector<EnsembleMember> members = membersFromSpecs(specs);
   LoadedInput loaded;
   loaded.kind = kind;
   try {
@@ -111,71 +94,23 @@ LoadedInput loadInput(const fs::path& input, const std::vector<std::string>& spe
                   "colorB.exr, <method>/…) nor a Tungsten buffer directory");
 }
 
-CombineOptions combineOptions(const DenoiseArgs& args) {
-  CombineOptions o;
-  o.solver = parseSolver(args.solver);
-  if (args.mseForm == "per-channel")
-    o.mse.form = MseForm::PerChannel;
-  else if (args.mseForm == "summed")
-    o.mse.form = MseForm::Summed;
-  else
-    throw Error("unknown --mse '" + args.mseForm + "' (known: per-channel, summed)");
-  if (args.window < 0) throw Error("--window must be at least 0");
-  o.mse.windowRadius = args.window;
-  o.mse.relative = args.relative;
-  if (args.weightFilter != "bilateral" && args.weightFilter != "none")
-    throw Error("unknown --weight-filter '" + args.weightFilter + "' (known: bilateral, none)");
-  o.filter.enabled = args.weightFilter == "bilateral";
-  o.seed = args.seed;
-  return o;
-}
-
-Json metricsJson(const Image& image, const Image& reference) {
-  const ImageMetrics m = computeMetrics(image, reference);
-  Json j;
-  j["relmse"] = m.relMse;
-  j["dssim"] = m.dssim;
-  j["psnr"] = std::isfinite(m.psnr) ? Json(m.psnr) : Json();
-  return j;
-}
-
-void writeResult(const fs::path& out, const std::string& name, const CombineResult& result,
-                 const std::vector<BaseOutputs>& bases, const std::string& weightsFile) {
-  writeExr(out / (name + ".exr"), {{"", result.image},
-                                   {"A", result.imageA},
-                                   {"B", result.imageB},
-                                   {"mseEstimate", result.mseEstimate}});
-  writePng(out / (name + ".png"), result.image);
-  std::vector<ExrLayer> weights;
-  for (size_t i = 0; i < bases.size(); ++i) weights.push_back({bases[i].name, result.weights[i]});
-  writeExr(out / weightsFile, weights);
-}
-
 void runDenoise(const DenoiseArgs& args) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch total;
   const std::vector<std::string> specs = splitMethodList(args.methods);
   std::vector<Combiner> combiners;
   for (const std::string& name : splitMethodList(args.combine))
     combiners.push_back(parseCombiner(name));
-  const CombineOptions options = combineOptions(args);
+  const CombineOptions options = args.ensemble.options();
   const fs::path out = args.out;
 
   LoadedInput input = loadInput(args.input, specs);
   std::optional<Image> reference;
-  if (!args.reference.empty()) {
-    reference = readExrLayer(args.reference);
-    if (reference->channels() == 4) reference = reference->channelRange(0, 3);
-    if (reference->channels() != 3 || !reference->sameSize(input.guides.color))
-      throw fileError(args.reference, "is " + std::to_string(reference->width()) + "x" +
-                                          std::to_string(reference->height()) + "x" +
-                                          std::to_string(reference->channels()) + ", expected " +
-                                          std::to_string(input.guides.width()) + "x" +
-                                          std::to_string(input.guides.height()) + "x3");
-  }
+  if (!args.reference.empty())
+    reference = readReference(args.reference, input.guides.width(), input.guides.height());
   for (Combiner c : combiners)
     if (needsReference(c) && !reference)
       throw Error("--combine " + std::string(combinerName(c)) + " needs --reference");
-  input.times.insert(input.times.begin(), {"read", secondsSince(start)});
+  input.times.insert(input.times.begin(), {"read", total.seconds()});
   checkEnsembleInputs(input.guides, pointersTo(input.bases));
   ensureDirectory(out);
 
@@ -185,12 +120,7 @@ void runDenoise(const DenoiseArgs& args) {
   stats["width"] = input.guides.width();
   stats["height"] = input.guides.height();
   stats["methods"] = specs;
-  stats["options"] = {{"solver", args.solver},
-                      {"mse", args.mseForm},
-                      {"window", args.window},
-                      {"relative", args.relative},
-                      {"weight_filter", args.weightFilter},
-                      {"seed", args.seed}};
+  stats["options"] = args.ensemble.json();
   Json times = Json::object(), metrics = Json::object();
   for (const StageTime& t : input.times) times[t.stage] = t.seconds;
   for (size_t k = 0; k < combiners.size(); ++k) {
@@ -200,17 +130,16 @@ void runDenoise(const DenoiseArgs& args) {
     const CombineResult result =
         combine(input.guides, pointersTo(input.bases), o, reference ? &*reference : nullptr);
     for (const StageTime& t : result.times) times[name + "/" + t.stage] = t.seconds;
-    const auto writeStart = std::chrono::steady_clock::now();
-    writeResult(out, name, result, input.bases,
+    const Stopwatch write;
+    writeCombined(out, name, result, input.bases,
                 k == 0 ? "weights.exr" : "weights-" + name + ".exr");
-    times[name + "/write"] = secondsSince(writeStart);
+    times[name + "/write"] = write.seconds();
     if (reference) metrics[name] = metricsJson(result.image, *reference);
     std::cout << "wrote " << (out / (name + ".exr")).string() << "\n";
   }
-  const auto writeStart = std::chrono::steady_clock::now();
-  for (const BaseOutputs& base : input.bases)
-    writeExr(out / (base.name + ".exr"), {{"", base.full}, {"A", base.a}, {"B", base.b}});
-  times["write bases"] = secondsSince(writeStart);
+  const Stopwatch writeBases;
+  writeBaseOutputs(out, input.bases);
+  times["write bases"] = writeBases.seconds();
   if (reference) {
     metrics["noisy"] = metricsJson(input.guides.color, *reference);
     for (const BaseOutputs& base : input.bases)
@@ -218,7 +147,7 @@ void runDenoise(const DenoiseArgs& args) {
     stats["reference"] = args.reference;
     stats["metrics"] = metrics;
   }
-  times["total"] = secondsSince(start);
+  times["total"] = total.seconds();
   stats["seconds"] = times;
   writeTextAtomically(out / "stats.json", stats.dump(2) + "\n");
   std::cout << "wrote " << (out / "stats.json").string() << "\n";
@@ -244,26 +173,9 @@ const RegisterCommand registration(40, [](CLI::App& app) {
                   "Combiner, or a comma-separated list: ensemble, average, onehot-pre, "
                   "onehot-post, oracle, oracle-unconstrained (oracles need --reference)")
       ->capture_default_str();
-  cmd->add_option("--solver", args->solver,
-                  "Weight solver: active-set (exact) or pairwise (the "
-                  "paper's iteration)")
-      ->capture_default_str();
-  cmd->add_option("--weight-filter", args->weightFilter,
-                  "bilateral (joint bilateral on normal, albedo and the blend, radius 7) or none")
-      ->capture_default_str();
-  cmd->add_option(
-         "--mse", args->mseForm,
-         "MSE matrix per-channel (one weight per colour channel) or summed (one per pixel)")
-      ->capture_default_str();
-  cmd->add_option("--window", args->window,
-                  "Radius of the feature-guided window the MSE estimate is accumulated over "
-                  "(0 = per pixel, as in the paper)")
-      ->capture_default_str();
-  cmd->add_flag("--relative,!--absolute", args->relative,
-                "Divide the MSE estimate by (mean² + 0.01) so that it targets relMSE");
+  args->ensemble.addFlags(*cmd);
   cmd->add_option("--reference", args->reference,
                   "Reference image (.exr): metrics in stats.json, and the oracle combiners");
-  cmd->add_option("--seed", args->seed, "Seed of the pairwise solver")->capture_default_str();
   cmd->callback([args] { runDenoise(*args); });
 });
 

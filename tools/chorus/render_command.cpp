@@ -12,10 +12,9 @@
 #include "denoise/util/atomic_file.h"
 #include "denoise/util/error.h"
 #include "renderer/render.h"
-#include "renderer/scene/environment.h"
-#include "renderer/scene/gltf_loader.h"
 #include "tools/chorus/command.h"
 #include "tools/chorus/progress_bar.h"
+#include "tools/chorus/scene_options.h"
 
 namespace chorus::cli {
 namespace {
@@ -26,10 +25,8 @@ using namespace chorus::render;
 struct RenderArgs {
   std::string scene;
   std::string out = "out";
-  RenderOptions options;
-  int splits = 0;  // 0: what the denoising stage needs
-  std::string background, env;
-  float envRotate = 0, envIntensity = 1;
+  SceneOptions sceneOptions;  // sceneOptions.render carries --spp too
+  int splits = 0;             // 0: what the denoising stage needs
   std::string denoise = "none";
   bool quiet = false;
 };
@@ -47,45 +44,30 @@ DenoiseStage parseDenoiseStage(const std::string& spec) {
   return {spec};
 }
 
-EnvironmentDesc environmentFrom(const RenderArgs& args) {
-  if (!args.env.empty()) return environmentFromFile(args.env, args.envRotate, args.envIntensity);
-  if (!args.background.empty()) {
-    EnvironmentDesc e = EnvironmentDesc::constant(parseRgb(args.background));
-    e.intensity = args.envIntensity;
-    return e;
-  }
-  return {};
-}
 
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderStats& s, double loadSeconds,
-                                 double buildSeconds, const Scene& scene,
-                                 const std::vector<std::string>& warnings) {
+nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderStats& s,
+                                 const LoadedScene& loaded) {
+  const RenderOptions& options = args.sceneOptions.render;
   nlohmann::ordered_json j;
   j["scene"] = args.scene;
   j["width"] = s.width;
   j["height"] = s.height;
   j["spp"] = s.spp;
   j["splits"] = s.splits;
-  j["seed"] = args.options.seed;
-  j["max_depth"] = args.options.maxDepth;
-  j["camera"] = args.options.camera;
-  j["threads"] = args.options.threads;
-  j["environment"] = scene.usesDefaultEnvironment() ? "default white (no lights in scene)"
-                     : !args.env.empty()            ? args.env
-                     : !args.background.empty()     ? "constant " + args.background
-                                                    : "none";
-  j["seconds"] = {{"load", loadSeconds}, {"bvh_build", buildSeconds}, {"render", s.renderSeconds}};
+  j["seed"] = options.seed;
+  j["max_depth"] = options.maxDepth;
+  j["camera"] = options.camera;
+  j["threads"] = options.threads;
+  j["environment"] = args.sceneOptions.environmentLabel(loaded.scene);
+  j["seconds"] = {
+      {"load", loaded.loadSeconds}, {"bvh_build", loaded.buildSeconds}, {"render", s.renderSeconds}};
   j["samples"] = s.samples;
   j["samples_per_second"] = s.samplesPerSecond();
   j["rays"] = s.rays;
   j["rays_per_second"] = s.raysPerSecond();
   j["triangles"] = s.triangles;
   j["nan_samples_dropped"] = s.nanSamplesDropped;
-  j["warnings"] = warnings;
+  j["warnings"] = loaded.warnings;
   j["denoise"] = args.denoise;
   j["chorus_version"] = CHORUS_VERSION;
   return j;
@@ -93,32 +75,19 @@ nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderStats& s, d
 
 void runRender(RenderArgs args) {
   const DenoiseStage denoise = parseDenoiseStage(args.denoise);
-  args.options.splits = args.splits > 0 ? args.splits : denoise.splitsNeeded();
-  const EnvironmentDesc environment = environmentFrom(args);
-
-  auto start = std::chrono::steady_clock::now();
-  SceneDesc desc = loadGltf(args.scene);
-  const double loadSeconds = secondsSince(start);
-  const std::vector<std::string> warnings = desc.warnings;
-  for (const std::string& w : warnings)
-    std::cerr << "chorus: warning: " << args.scene << ": " << w << "\n";
-
-  start = std::chrono::steady_clock::now();
-  const Scene scene = buildScene(std::move(desc), environment);
-  const double buildSeconds = secondsSince(start);
-  if (scene.usesDefaultEnvironment() && !args.quiet)
-    std::cerr << "chorus: " << args.scene
-              << " has no lights: rendering under a uniform white environment (radiance 1)\n";
+  RenderOptions options = args.sceneOptions.render;
+  options.splits = args.splits > 0 ? args.splits : denoise.splitsNeeded();
+  const LoadedScene loaded = loadScene(args.scene, args.sceneOptions, args.quiet);
 
   ProgressBar bar(!args.quiet && ProgressBar::stderrIsTerminal());
   RenderResult result =
-      render::render(scene, args.options, [&bar](const RenderProgress& p) { bar.update(p); });
+      render::render(loaded.scene, options, [&bar](const RenderProgress& p) { bar.update(p); });
   bar.finish();
 
   const fs::path out = args.out;
   ensureDirectory(out);
   nlohmann::ordered_json stats =
-      statsJson(args, result.stats, loadSeconds, buildSeconds, scene, warnings);
+      statsJson(args, result.stats, loaded);
   denoise.run(result.buffers, out, stats);
   // The buffers move into the EXR layers (no second copy of a large render in memory).
   const std::vector<ExrLayer> layers = sampleBuffersToLayers(std::move(result.buffers));
@@ -145,33 +114,13 @@ const RegisterCommand registration(30, [](CLI::App& app) {
       "depth, visibility, with variances); writes DIR/render.exr, color.png, stats.json");
   cmd->add_option("scene", args->scene, "glTF scene (.gltf or .glb)")->required();
   cmd->add_option("--out", args->out, "Output directory")->capture_default_str();
-  cmd->add_option("--spp", args->options.spp, "Samples per pixel (over all sub-buffers)")
+  cmd->add_option("--spp", args->sceneOptions.render.spp, "Samples per pixel (over all sub-buffers)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--width", args->options.width, "Image width (default: from the camera)");
-  cmd->add_option("--height", args->options.height, "Image height (default: 512, or from --width)");
   cmd->add_option("--splits", args->splits,
                   "Independent sub-buffers K: 1, 2 or 4 (default: what --denoise needs)")
       ->check(CLI::IsMember({1, 2, 4}));
-  cmd->add_option("--seed", args->options.seed, "Sampler seed")->capture_default_str();
-  cmd->add_option("--threads", args->options.threads, "Worker threads (0: all cores)")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--max-depth", args->options.maxDepth, "Maximum bounces per path")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--camera", args->options.camera, "Camera index (glTF camera nodes in order)")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
-  auto* background = cmd->add_option("--background", args->background,
-                                     "Constant environment radiance R,G,B (or one grey value)");
-  auto* env = cmd->add_option("--env", args->env, "Equirectangular environment map (.hdr or .exr)");
-  background->excludes(env);
-  cmd->add_option("--env-rotate", args->envRotate, "Rotate the environment about +Y, degrees")
-      ->capture_default_str();
-  cmd->add_option("--env-intensity", args->envIntensity, "Scale the environment radiance")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+  args->sceneOptions.addFlags(*cmd);
   cmd->add_option("--denoise", args->denoise, "Denoising after the render: none")
       ->capture_default_str();
   cmd->add_flag("--quiet", args->quiet, "No progress bar or summary line");

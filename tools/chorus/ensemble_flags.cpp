@@ -1,0 +1,51 @@
+#include "tools/chorus/ensemble_flags.h"
+
+#include "denoise/util/error.h"
+
+namespace chorus::cli {
+
+void EnsembleFlags::addFlags(CLI::App& cmd) {
+  cmd.add_option("--solver", solver,
+                 "Weight solver: active-set (exact) or pairwise (the paper's iteration)")
+      ->capture_default_str();
+  cmd.add_option("--weight-filter", weightFilter,
+                 "bilateral (joint bilateral on normal, albedo and the blend, radius 7) or none")
+      ->capture_default_str();
+  cmd.add_option("--mse", mseForm,
+                 "MSE matrix per-channel (one weight per colour channel) or summed (one per pixel)")
+      ->capture_default_str();
+  cmd.add_option("--window", window,
+                 "Radius of the feature-guided window the MSE estimate is accumulated over "
+                 "(0 = per pixel, as in the paper)")
+      ->capture_default_str();
+  cmd.add_flag("--relative,!--absolute", relative,
+               "Divide the MSE estimate by (mean² + 0.01) so that it targets relMSE");
+  cmd.add_option("--solver-seed", seed, "Seed of the pairwise solver")->capture_default_str();
+}
+
+CombineOptions EnsembleFlags::options() const {
+  CombineOptions o;
+  o.solver = parseSolver(solver);
+  if (mseForm == "per-channel")
+    o.mse.form = MseForm::PerChannel;
+  else if (mseForm == "summed")
+    o.mse.form = MseForm::Summed;
+  else
+    throw Error("unknown --mse '" + mseForm + "' (known: per-channel, summed)");
+  if (window < 0) throw Error("--window must be at least 0");
+  o.mse.windowRadius = window;
+  o.mse.relative = relative;
+  if (weightFilter != "bilateral" && weightFilter != "none")
+    throw Error("unknown --weight-filter '" + weightFilter + "' (known: bilateral, none)");
+  o.filter.enabled = weightFilter == "bilateral";
+  o.seed = seed;
+  return o;
+}
+
+nlohmann::ordered_json EnsembleFlags::json() const {
+  return {{"solver", solver},   {"mse", mseForm},
+          {"window", window},   {"relative", relative},
+          {"weight_filter", weightFilter}, {"seed", seed}};
+}
+
+}  // namespace chorus::cli

@@ -1,0 +1,26 @@
+#pragma once
+// The ensemble flags shared by `chorus denoise` and `chorus render --denoise`: solver, MSE
+// form and window, relative objective, weight filter, seed.
+#include <CLI/CLI.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+#include "denoise/ensemble/combiners.h"
+
+namespace chorus::cli {
+
+struct EnsembleFlags {
+  std::string solver = "active-set", weightFilter = "bilateral", mseForm = "summed";
+  int window = MseOptions{}.windowRadius;
+  bool relative = MseOptions{}.relative;
+  uint64_t seed = 1;
+
+  void addFlags(CLI::App& cmd);
+  // Throws chorus::Error for an unknown value.
+  CombineOptions options() const;
+  nlohmann::ordered_json json() const;
+};
+
+}  // namespace chorus::cli

@@ -1,0 +1,68 @@
+#include "tools/chorus/ensemble_outputs.h"
+
+#include <cctype>
+#include <cmath>
+
+#include "denoise/base/registry.h"
+#include "denoise/image/exr_io.h"
+#include "denoise/image/png_io.h"
+#include "denoise/metrics/metrics.h"
+#include "denoise/util/error.h"
+
+namespace chorus::cli {
+
+std::string labelOf(const std::string& spec) {
+  std::string label = spec;
+  for (char& c : label)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' ||
+          c == '=' || c == '+'))
+      c = '_';
+  return label;
+}
+
+std::vector<EnsembleMember> membersFromSpecs(const std::vector<std::string>& specs) {
+  std::vector<EnsembleMember> members;
+  for (const std::string& spec : specs)
+    members.push_back({labelOf(spec), std::shared_ptr<const BaseDenoiser>(createDenoiser(spec))});
+  return members;
+}
+
+Image readReference(const std::filesystem::path& path, int width, int height) {
+  Image reference = readExrLayer(path);
+  if (reference.channels() == 4) reference = reference.channelRange(0, 3);
+  if (reference.channels() != 3 || reference.width() != width || reference.height() != height)
+    throw fileError(path, "is " + std::to_string(reference.width()) + "x" +
+                              std::to_string(reference.height()) + "x" +
+                              std::to_string(reference.channels()) + ", expected " +
+                              std::to_string(width) + "x" + std::to_string(height) + "x3");
+  return reference;
+}
+
+nlohmann::ordered_json metricsJson(const Image& image, const Image& reference) {
+  const ImageMetrics m = computeMetrics(image, reference);
+  nlohmann::ordered_json j;
+  j["relmse"] = m.relMse;
+  j["dssim"] = m.dssim;
+  j["psnr"] = std::isfinite(m.psnr) ? nlohmann::ordered_json(m.psnr) : nlohmann::ordered_json();
+  return j;
+}
+
+void writeCombined(const std::filesystem::path& dir, const std::string& name,
+                   const CombineResult& result, const std::vector<BaseOutputs>& bases,
+                   const std::string& weightsFile) {
+  writeExr(dir / (name + ".exr"), {{"", result.image},
+                                   {"A", result.imageA},
+                                   {"B", result.imageB},
+                                   {"mseEstimate", result.mseEstimate}});
+  writePng(dir / (name + ".png"), result.image);
+  std::vector<ExrLayer> weights;
+  for (size_t i = 0; i < bases.size(); ++i) weights.push_back({bases[i].name, result.weights[i]});
+  writeExr(dir / weightsFile, weights);
+}
+
+void writeBaseOutputs(const std::filesystem::path& dir, const std::vector<BaseOutputs>& bases) {
+  for (const BaseOutputs& base : bases)
+    writeExr(dir / (base.name + ".exr"), {{"", base.full}, {"A", base.a}, {"B", base.b}});
+}
+
+}  // namespace chorus::cli

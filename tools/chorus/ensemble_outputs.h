@@ -1,0 +1,38 @@
+#pragma once
+// What `chorus denoise` and `chorus render --denoise` share: building members from method
+// specs, reading a reference, and writing a combined result, its weight maps and the base
+// outputs.
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "denoise/ensemble/ensemble.h"
+
+namespace chorus::cli {
+
+// A method spec as a file and layer name: "nlm:k=0.4" → "nlm_k=0.4".
+std::string labelOf(const std::string& spec);
+
+// One member per spec (registry names with optional parameters); throws chorus::Error for an
+// unknown name or parameter.
+std::vector<EnsembleMember> membersFromSpecs(const std::vector<std::string>& specs);
+
+// Reads an RGB (or RGBA, alpha dropped) reference of the given size; throws chorus::Error
+// naming the file otherwise.
+Image readReference(const std::filesystem::path& path, int width, int height);
+
+// {"relmse", "dssim", "psnr"} of image against reference (PSNR null when infinite).
+nlohmann::ordered_json metricsJson(const Image& image, const Image& reference);
+
+// DIR/<name>.exr (layers: RGB = the blend, A, B, mseEstimate), DIR/<name>.png and the weight
+// maps as DIR/<weightsFile>, one layer per base.
+void writeCombined(const std::filesystem::path& dir, const std::string& name,
+                   const CombineResult& result, const std::vector<BaseOutputs>& bases,
+                   const std::string& weightsFile);
+
+// DIR/<base>.exr for every base: RGB = the full-buffer output, layers A and B.
+void writeBaseOutputs(const std::filesystem::path& dir, const std::vector<BaseOutputs>& bases);
+
+}  // namespace chorus::cli

@@ -1,0 +1,72 @@
+#include "tools/chorus/scene_options.h"
+
+#include <chrono>
+#include <iostream>
+
+#include "renderer/scene/environment.h"
+#include "renderer/scene/gltf_loader.h"
+
+namespace chorus::cli {
+
+using namespace chorus::render;
+
+void SceneOptions::addFlags(CLI::App& cmd) {
+  cmd.add_option("--width", render.width, "Image width (default: from the camera)");
+  cmd.add_option("--height", render.height, "Image height (default: 512, or from --width)");
+  cmd.add_option("--seed", render.seed, "Sampler seed")->capture_default_str();
+  cmd.add_option("--threads", render.threads, "Worker threads (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--max-depth", render.maxDepth, "Maximum bounces per path")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd.add_option("--camera", render.camera, "Camera index (glTF camera nodes in order)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  auto* backgroundFlag = cmd.add_option("--background", background,
+                                        "Constant environment radiance R,G,B (or one grey value)");
+  auto* envFlag = cmd.add_option("--env", env, "Equirectangular environment map (.hdr or .exr)");
+  backgroundFlag->excludes(envFlag);
+  cmd.add_option("--env-rotate", envRotate, "Rotate the environment about +Y, degrees")
+      ->capture_default_str();
+  cmd.add_option("--env-intensity", envIntensity, "Scale the environment radiance")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+}
+
+EnvironmentDesc SceneOptions::environment() const {
+  if (!env.empty()) return environmentFromFile(env, envRotate, envIntensity);
+  if (!background.empty()) {
+    EnvironmentDesc e = EnvironmentDesc::constant(parseRgb(background));
+    e.intensity = envIntensity;
+    return e;
+  }
+  return {};
+}
+
+std::string SceneOptions::environmentLabel(const Scene& scene) const {
+  if (scene.usesDefaultEnvironment()) return "default white (no lights in scene)";
+  if (!env.empty()) return env;
+  if (!background.empty()) return "constant " + background;
+  return "none";
+}
+
+LoadedScene loadScene(const std::string& path, const SceneOptions& options, bool quiet) {
+  using Clock = std::chrono::steady_clock;
+  const EnvironmentDesc environment = options.environment();
+  auto start = Clock::now();
+  SceneDesc desc = loadGltf(path);
+  const double loadSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+  std::vector<std::string> warnings = desc.warnings;
+  for (const std::string& w : warnings) std::cerr << "chorus: warning: " << path << ": " << w << "\n";
+
+  start = Clock::now();
+  Scene scene = buildScene(std::move(desc), environment);
+  const double buildSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (scene.usesDefaultEnvironment() && !quiet)
+    std::cerr << "chorus: " << path
+              << " has no lights: rendering under a uniform white environment (radiance 1)\n";
+  return {std::move(scene), loadSeconds, buildSeconds, std::move(warnings)};
+}
+
+}  // namespace chorus::cli

@@ -2,6 +2,7 @@
 // (one line naming the file, exit code 2, nothing written).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -45,9 +46,9 @@ TEST(RenderCli, WritesExrPngAndStats) {
   const auto scene = writeLitScene(dir);
   const auto out = dir / "out";
   const auto r = runChorus({"render", scene.string(), "--spp", "8", "--width", "12", "--splits",
-                            "4", "--seed", "3", "--out", out.string()});
+                            "4", "--seed", "3", "--denoise", "none", "--out", out.string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
-  EXPECT_EQ(lineCount(r.err), 1) << r.err;                    // not a terminal: one summary line
+  EXPECT_EQ(lineCount(r.err), 2) << r.err;  // not a terminal: render and output summary lines
   EXPECT_NE(r.err.find("12x8"), std::string::npos) << r.err;  // height from the camera's aspect
   for (const char* f : {"render.exr", "color.png", "stats.json"})
     EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
@@ -78,20 +79,20 @@ TEST(RenderCli, QuietPrintsNothingAndNoLightsGetsOneLine) {
   TempDir dir;
   const auto scene = writeLitScene(dir, false);
   auto r = runChorus({"render", scene.string(), "--spp", "1", "--width", "4", "--height", "4",
-                      "--quiet", "--out", (dir / "q").string()});
+                      "--quiet", "--denoise", "none", "--out", (dir / "q").string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_EQ(r.err, "");
   EXPECT_EQ(r.out, "");
-  r = runChorus({"render", scene.string(), "--spp", "1", "--width", "4", "--height", "4", "--out",
-                 (dir / "n").string()});
+  r = runChorus({"render", scene.string(), "--spp", "1", "--width", "4", "--height", "4",
+                 "--denoise", "none", "--out", (dir / "n").string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.err.find("has no lights: rendering under a uniform white environment (radiance 1)"),
             std::string::npos)
       << r.err;
-  EXPECT_EQ(lineCount(r.err), 2) << r.err;
+  EXPECT_EQ(lineCount(r.err), 3) << r.err;
   // With an explicit background the scene is lit by it and nothing is said.
   r = runChorus({"render", scene.string(), "--spp", "1", "--width", "4", "--height", "4",
-                 "--background", "0.5,0.25,0", "--out", (dir / "b").string()});
+                 "--background", "0.5,0.25,0", "--denoise", "none", "--out", (dir / "b").string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_EQ(r.err.find("no lights"), std::string::npos) << r.err;
 }
@@ -118,8 +119,17 @@ TEST(RenderCli, FailsCleanlyOnBadInput) {
                      "broken.gltf: not a readable glTF", out);
   expectCleanFailure({"render", scene.string(), "--camera", "3", "--out", o}, "has no camera 3",
                      out);
-  expectCleanFailure({"render", scene.string(), "--denoise", "nfor", "--out", o},
-                     "--denoise 'nfor'", out);
+  expectCleanFailure({"render", scene.string(), "--denoise", "atrous,foo", "--out", o},
+                     "unknown denoiser 'foo'", out);
+  expectCleanFailure({"render", scene.string(), "--denoise", "jnlm:k=x", "--out", o},
+                     "denoiser jnlm: parameter k=x is not a number", out);
+  expectCleanFailure({"render", scene.string(), "--splits", "2", "--out", o},
+                     "--denoise needs 4 sub-buffers", out);
+  expectCleanFailure({"render", scene.string(), "--combine", "oracle", "--out", o},
+                     "needs a reference", out);
+  expectCleanFailure({"render", scene.string(), "--reference", (dir / "ref.exr").string(),
+                      "--out", o},
+                     "ref.exr: no such file", out);
   expectCleanFailure({"render", scene.string(), "--env", (dir / "sky.hdr").string(), "--out", o},
                      "sky.hdr: no such file", out);
   expectCleanFailure({"render", scene.string(), "--background", "red", "--out", o},
@@ -132,9 +142,84 @@ TEST(RenderCli, FailsCleanlyOnBadInput) {
   EXPECT_FALSE(std::filesystem::exists(out));
   // An output path that is a file.
   std::ofstream(dir / "file") << "x";
-  expectCleanFailure(
-      {"render", scene.string(), "--spp", "1", "--width", "4", "--out", (dir / "file").string()},
+  expectCleanFailure({"render", scene.string(), "--spp", "1", "--width", "4", "--denoise", "none",
+                      "--out", (dir / "file").string()},
       "file", dir / "file");
+}
+
+json readJson(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  return json::parse(in);
+}
+
+// The in-process ensemble gives exactly what `chorus denoise` computes from the written
+// render.exr, beats the noisy render against a high-spp reference, and times every stage.
+TEST(RenderCli, DenoisesInProcessLikeChorusDenoiseOnTheWrittenRender) {
+  TempDir dir;
+  const auto scene = test::sourceDir() / "scenes" / "cornell-box.gltf";
+  const std::string size[] = {"--width", "32", "--seed", "1"};
+  auto r = runChorus({"render", scene.string(), size[0], size[1], size[2], size[3], "--spp",
+                      "1024", "--denoise", "none", "--out", (dir / "ref").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto out = dir / "out";
+  r = runChorus({"render", scene.string(), size[0], size[1], "--spp", "8", "--denoise",
+                 "atrous,jnlm", "--reference", (dir / "ref" / "color.png").string(), "--out",
+                 out.string()});
+  EXPECT_EQ(r.exitCode, 2);  // a PNG is not a reference; nothing was rendered
+  EXPECT_FALSE(std::filesystem::exists(out / "render.exr"));
+  // The reference is the full-buffer colour layer of the high-spp render.exr.
+  r = runChorus({"render", scene.string(), size[0], size[1], "--spp", "8", "--denoise",
+                 "atrous,jnlm", "--reference", (dir / "ref" / "render.exr").string(), "--out",
+                 out.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("denoised with atrous,jnlm (ensemble)"), std::string::npos) << r.err;
+  for (const char* f : {"render.exr", "color.png", "denoised.exr", "denoised.png", "weights.exr",
+                        "atrous.exr", "jnlm.exr", "stats.json"})
+    EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
+
+  r = runChorus({"denoise", (out / "render.exr").string(), "--methods", "atrous,jnlm", "--out",
+                 (dir / "cli").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const Image inProcess = readExrLayer(out / "denoised.exr");
+  const Image fromFile = readExrLayer(dir / "cli" / "ensemble.exr");
+  ASSERT_TRUE(inProcess.sameSize(fromFile));
+  EXPECT_TRUE(std::equal(inProcess.values().begin(), inProcess.values().end(),
+                         fromFile.values().begin()));
+  const std::vector<ExrLayer> weights = readExr(out / "weights.exr");
+  ASSERT_EQ(weights.size(), 2u);
+  EXPECT_EQ(weights[0].name, "atrous");
+  EXPECT_EQ(weights[1].name, "jnlm");
+  for (int y = 0; y < weights[0].image.height(); ++y)
+    for (int x = 0; x < weights[0].image.width(); ++x)
+      EXPECT_NEAR(weights[0].image.at(x, y, 0) + weights[1].image.at(x, y, 0), 1.0, 1e-5);
+
+  const json stats = readJson(out / "stats.json");
+  EXPECT_EQ(stats["splits"], 4);
+  for (const char* stage : {"render", "write render", "atrous/A", "atrous/B", "atrous/full",
+                            "jnlm/A", "jnlm/B", "jnlm/full", "bases", "solve", "filter", "blend",
+                            "write denoised", "total"})
+    EXPECT_GE(stats["seconds"][stage].get<double>(), 0.0) << stage;
+  EXPECT_EQ(stats["denoise"]["methods"], json({"atrous", "jnlm"}));
+  const json& m = stats["metrics"];
+  EXPECT_LT(m["denoised"]["relmse"].get<double>(), 0.5 * m["noisy"]["relmse"].get<double>());
+  EXPECT_LT(m["atrous"]["relmse"].get<double>(), m["noisy"]["relmse"].get<double>());
+}
+
+TEST(RenderCli, PreviewWritesOnlyThePngAndStats) {
+  TempDir dir;
+  const auto scene = writeLitScene(dir);
+  const auto out = dir / "preview";
+  const auto r =
+      runChorus({"render", scene.string(), "--width", "24", "--preview", "--out", out.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::vector<std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(out))
+    files.push_back(entry.path().filename().string());
+  std::sort(files.begin(), files.end());
+  EXPECT_EQ(files, (std::vector<std::string>{"denoised.png", "stats.json"}));
+  const json stats = readJson(out / "stats.json");
+  EXPECT_EQ(stats["spp"], 4);
+  EXPECT_EQ(stats["denoise"]["methods"], json({"atrous", "bilateral"}));
 }
 
 TEST(InfoCli, SummarisesTheScene) {

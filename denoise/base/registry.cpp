@@ -56,7 +56,12 @@ std::unique_ptr<BaseDenoiser> createDenoiser(const std::string& spec) {
     if (entry.name != name) continue;
     ParamMap params =
         colon == std::string::npos ? ParamMap() : ParamMap::parse(spec.substr(colon + 1), name);
-    auto denoiser = entry.create(params);
+    std::unique_ptr<BaseDenoiser> denoiser;
+    try {
+      denoiser = entry.create(params);
+    } catch (const Error& e) {  // a bad value: say which denoiser it was for
+      throw Error("denoiser " + name + ": " + e.what());
+    }
     params.rejectUnread("denoiser " + name);
     return denoiser;
   }

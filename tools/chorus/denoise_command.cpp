@@ -120,7 +120,8 @@ void runDenoise(const DenoiseArgs& args) {
   stats["width"] = input.guides.width();
   stats["height"] = input.guides.height();
   stats["methods"] = specs;
-  stats["options"] = args.ensemble.json();
+  stats["options"] = combineOptionsJson(options);
+  stats["options"].erase("combine");  // one run per --combine value
   Json times = Json::object(), metrics = Json::object();
   for (const StageTime& t : input.times) times[t.stage] = t.seconds;
   for (size_t k = 0; k < combiners.size(); ++k) {

@@ -42,10 +42,4 @@ CombineOptions EnsembleFlags::options() const {
   return o;
 }
 
-nlohmann::ordered_json EnsembleFlags::json() const {
-  return {{"solver", solver},   {"mse", mseForm},
-          {"window", window},   {"relative", relative},
-          {"weight_filter", weightFilter}, {"seed", seed}};
-}
-
 }  // namespace chorus::cli

@@ -3,8 +3,6 @@
 // form and window, relative objective, weight filter, seed.
 #include <CLI/CLI.hpp>
 
-#include <nlohmann/json.hpp>
-
 #include <string>
 
 #include "denoise/ensemble/combiners.h"
@@ -20,7 +18,6 @@ struct EnsembleFlags {
   void addFlags(CLI::App& cmd);
   // Throws chorus::Error for an unknown value.
   CombineOptions options() const;
-  nlohmann::ordered_json json() const;
 };
 
 }  // namespace chorus::cli

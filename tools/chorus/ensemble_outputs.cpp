@@ -47,6 +47,16 @@ nlohmann::ordered_json metricsJson(const Image& image, const Image& reference) {
   return j;
 }
 
+nlohmann::ordered_json combineOptionsJson(const CombineOptions& o) {
+  return {{"combine", combinerName(o.combiner)},
+          {"solver", solverName(o.solver)},
+          {"mse", o.mse.form == MseForm::Summed ? "summed" : "per-channel"},
+          {"window", o.mse.windowRadius},
+          {"relative", o.mse.relative},
+          {"weight_filter", o.filter.enabled ? "bilateral" : "none"},
+          {"solver_seed", o.seed}};
+}
+
 void writeCombined(const std::filesystem::path& dir, const std::string& name,
                    const CombineResult& result, const std::vector<BaseOutputs>& bases,
                    const std::string& weightsFile) {

@@ -26,6 +26,9 @@ Image readReference(const std::filesystem::path& path, int width, int height);
 // {"relmse", "dssim", "psnr"} of image against reference (PSNR null when infinite).
 nlohmann::ordered_json metricsJson(const Image& image, const Image& reference);
 
+// The options of a combination, for stats.json.
+nlohmann::ordered_json combineOptionsJson(const CombineOptions& options);
+
 // DIR/<name>.exr (layers: RGB = the blend, A, B, mseEstimate), DIR/<name>.png and the weight
 // maps as DIR/<weightsFile>, one layer per base.
 void writeCombined(const std::filesystem::path& dir, const std::string& name,

@@ -1,8 +1,10 @@
-// chorus render SCENE: path-trace a glTF scene into K independent sub-buffers and write
-// DIR/render.exr (every layer), DIR/color.png (preview) and DIR/stats.json.
+// chorus render SCENE: path-trace a glTF scene into K independent sub-buffers, write
+// DIR/render.exr (every layer), DIR/color.png and DIR/stats.json, then (unless --denoise none)
+// denoise in the same process: DIR/denoised.exr/.png, weights.exr and one EXR per member.
+// --preview: 4 spp, the fast members, DIR/denoised.png and stats.json only.
 #include <nlohmann/json.hpp>
 
-#include <chrono>
+#include <optional>
 #include <iostream>
 #include <string>
 
@@ -11,9 +13,13 @@
 #include "denoise/image/png_io.h"
 #include "denoise/util/atomic_file.h"
 #include "denoise/util/error.h"
+#include "denoise/util/stopwatch.h"
 #include "renderer/render.h"
 #include "tools/chorus/command.h"
 #include "tools/chorus/progress_bar.h"
+#include "tools/chorus/ensemble_flags.h"
+#include "tools/chorus/ensemble_outputs.h"
+#include "tools/chorus/render_denoise.h"
 #include "tools/chorus/scene_options.h"
 
 namespace chorus::cli {
@@ -27,23 +33,21 @@ struct RenderArgs {
   std::string out = "out";
   SceneOptions sceneOptions;  // sceneOptions.render carries --spp too
   int splits = 0;             // 0: what the denoising stage needs
-  std::string denoise = "none";
+  std::string denoise = "default", combine = "ensemble", reference;
+  EnsembleFlags ensemble;
+  bool preview = false, sppGiven = false, denoiseGiven = false;
   bool quiet = false;
 };
 
-// The stage after rendering. Only "none" exists so far; the ensemble plugs in here: it parses
-// its spec, says how many sub-buffers it needs, and runs on the buffers after they are written.
-struct DenoiseStage {
-  std::string spec;
-  int splitsNeeded() const { return 1; }
-  void run(const SampleBuffers&, const fs::path&, nlohmann::ordered_json&) const {}
-};
-
-DenoiseStage parseDenoiseStage(const std::string& spec) {
-  if (spec != "none") throw Error("--denoise '" + spec + "' is not available (only 'none' so far)");
-  return {spec};
+DenoiseStage denoiseStageOf(const RenderArgs& args) {
+  CombineOptions options = args.ensemble.options();
+  options.combiner = parseCombiner(args.combine);
+  const std::string list = args.denoiseGiven ? args.denoise : args.preview ? "preview" : "default";
+  DenoiseStage stage = DenoiseStage::parse(list, options, !args.preview);
+  if (stage.enabled() && args.splits != 0 && args.splits != 4)
+    throw Error("--denoise needs 4 sub-buffers: omit --splits or give --splits 4");
+  return stage;
 }
-
 
 nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderStats& s,
                                  const LoadedScene& loaded) {
@@ -68,41 +72,76 @@ nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderStats& s,
   j["triangles"] = s.triangles;
   j["nan_samples_dropped"] = s.nanSamplesDropped;
   j["warnings"] = loaded.warnings;
-  j["denoise"] = args.denoise;
   j["chorus_version"] = CHORUS_VERSION;
   return j;
 }
 
 void runRender(RenderArgs args) {
-  const DenoiseStage denoise = parseDenoiseStage(args.denoise);
+  const Stopwatch total;
+  if (args.preview && !args.sppGiven) args.sceneOptions.render.spp = 4;
+  const DenoiseStage denoise = denoiseStageOf(args);
   RenderOptions options = args.sceneOptions.render;
   options.splits = args.splits > 0 ? args.splits : denoise.splitsNeeded();
+  std::optional<Image> reference;
+  if (!args.reference.empty()) {
+    if (!denoise.enabled()) throw Error("--reference needs --denoise");
+    reference = readExrLayer(args.reference);  // fails before the render; size checked after
+  }
   const LoadedScene loaded = loadScene(args.scene, args.sceneOptions, args.quiet);
+  const fs::path out = args.out;
+  if (fs::exists(out) && !fs::is_directory(out))  // fail before the render, not after
+    throw fileError(out, "cannot create directory: it is a file");
 
   ProgressBar bar(!args.quiet && ProgressBar::stderrIsTerminal());
   RenderResult result =
       render::render(loaded.scene, options, [&bar](const RenderProgress& p) { bar.update(p); });
   bar.finish();
-
-  const fs::path out = args.out;
-  ensureDirectory(out);
-  nlohmann::ordered_json stats =
-      statsJson(args, result.stats, loaded);
-  denoise.run(result.buffers, out, stats);
-  // The buffers move into the EXR layers (no second copy of a large render in memory).
-  const std::vector<ExrLayer> layers = sampleBuffersToLayers(std::move(result.buffers));
-  writeExr(out / "render.exr", layers, ExrPixelType::Float);
-  writePng(out / "color.png", layers.front().image);  // the full-buffer colour mean
-  writeTextAtomically(out / "stats.json", stats.dump(2) + "\n");
-
   if (!args.quiet) {
     const RenderStats& s = result.stats;
     std::fprintf(stderr,
                  "chorus: rendered %s at %dx%d, %d spp, %d split(s) in %.2f s: %.2f M samples/s, "
-                 "%.2f M rays/s, %llu NaN sample(s) dropped -> %s\n",
+                 "%.2f M rays/s, %llu NaN sample(s) dropped\n",
                  args.scene.c_str(), s.width, s.height, s.spp, s.splits, s.renderSeconds,
                  s.samplesPerSecond() / 1e6, s.raysPerSecond() / 1e6,
-                 static_cast<unsigned long long>(s.nanSamplesDropped), out.c_str());
+                 static_cast<unsigned long long>(s.nanSamplesDropped));
+  }
+
+  ensureDirectory(out);
+  nlohmann::ordered_json stats = statsJson(args, result.stats, loaded);
+  // The denoisers' inputs are copies, so the buffers can move into render.exr's layers (no
+  // second copy of a large render in memory), and render.exr is on disk before denoising.
+  std::optional<EnsembleSources> sources;
+  if (denoise.enabled()) sources = sourcesFromBuffers(result.buffers);
+  std::string written;
+  const Stopwatch write;
+  if (!args.preview) {
+    const std::vector<ExrLayer> layers = sampleBuffersToLayers(std::move(result.buffers));
+    writeExr(out / "render.exr", layers, ExrPixelType::Float);
+    writePng(out / "color.png", layers.front().image);  // the full-buffer colour mean
+    written = "render.exr color.png ";
+  } else if (!sources) {
+    writePng(out / "color.png", result.buffers.part(BufferPart::Full).color.mean);
+    written = "color.png ";
+  }
+  stats["seconds"]["write render"] = write.seconds();
+  result.buffers = {};
+  double denoiseSeconds = 0;
+  if (reference)  // checked after render.exr is safe on disk
+    *reference = readReference(args.reference, result.stats.width, result.stats.height);
+  if (sources) {
+    denoiseSeconds = denoise.run(*sources, out, stats, reference ? &*reference : nullptr);
+    written += denoise.writeExrs ? "denoised.exr denoised.png weights.exr <member>.exr "
+                                 : "denoised.png ";
+  }
+  written += "stats.json";
+  stats["seconds"]["total"] = total.seconds();
+  writeTextAtomically(out / "stats.json", stats.dump(2) + "\n");
+
+  if (!args.quiet) {
+    if (sources)
+      std::fprintf(stderr, "chorus: denoised with %s (%s) in %.2f s\n", denoise.label().c_str(),
+                   args.combine.c_str(), denoiseSeconds);
+    std::fprintf(stderr, "chorus: wrote %s in %s\n", written.c_str(), out.c_str());
   }
 }
 
@@ -116,13 +155,29 @@ const RegisterCommand registration(30, [](CLI::App& app) {
   cmd->add_option("--out", args->out, "Output directory")->capture_default_str();
   cmd->add_option("--spp", args->sceneOptions.render.spp, "Samples per pixel (over all sub-buffers)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->each([args](const std::string&) { args->sppGiven = true; });
   cmd->add_option("--splits", args->splits,
                   "Independent sub-buffers K: 1, 2 or 4 (default: what --denoise needs)")
       ->check(CLI::IsMember({1, 2, 4}));
   args->sceneOptions.addFlags(*cmd);
-  cmd->add_option("--denoise", args->denoise, "Denoising after the render: none")
+  cmd->add_option("--denoise", args->denoise,
+                  std::string("Denoising after the render: none, default (") + kDefaultDenoise +
+                      "), preview (" + kPreviewDenoise +
+                      ") or a comma-separated list of base denoisers (name or name:key=value; "
+                      "`chorus denoise --help` lists them)")
+      ->capture_default_str()
+      ->each([args](const std::string&) { args->denoiseGiven = true; });
+  cmd->add_option("--combine", args->combine,
+                  "How the members are blended: ensemble, average, onehot-pre, onehot-post")
       ->capture_default_str();
+  cmd->add_flag("--preview", args->preview,
+                std::string("Fast preview: 4 spp unless --spp, members ") + kPreviewDenoise +
+                    " unless --denoise, writes only denoised.png and stats.json");
+  cmd->add_option("--reference", args->reference,
+                  "Reference image (.exr) of the same view: metrics of the noisy input, each "
+                  "member and the result in stats.json");
+  args->ensemble.addFlags(*cmd);
   cmd->add_flag("--quiet", args->quiet, "No progress bar or summary line");
   cmd->callback([args] { runRender(*args); });
 });

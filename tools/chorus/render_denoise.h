@@ -1,0 +1,45 @@
+#pragma once
+// The denoising stage of `chorus render`: after the render, in the same process, the listed
+// base denoisers run on half A, half B and the full buffer (in parallel), their outputs are
+// blended by the ensemble (or another combiner), and the results are written next to
+// render.exr.
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "denoise/ensemble/combiners.h"
+#include "denoise/ensemble/ensemble_inputs.h"
+
+namespace chorus::cli {
+
+// The members `chorus render` uses when --denoise is not given, and with --preview (README:
+// the sweep evidence behind both).
+inline constexpr const char* kDefaultDenoise = "nfor,rdfc,jnlm,atrous";
+inline constexpr const char* kPreviewDenoise = "atrous,bilateral";
+
+struct DenoiseStage {
+  std::vector<std::string> specs;  // empty: render only (--denoise none)
+  CombineOptions options;
+  bool writeExrs = true;  // false for previews: denoised.png only
+
+  // From a --denoise value ("none", "default", "preview" or a comma-separated list of method
+  // specs). Throws chorus::Error for an unknown method or parameter.
+  static DenoiseStage parse(const std::string& list, CombineOptions options, bool writeExrs);
+
+  std::string label() const;  // "nfor,rdfc,..."
+  bool enabled() const { return !specs.empty(); }
+  int splitsNeeded() const { return enabled() ? 4 : 1; }
+
+  // Runs the members and the combiner on `sources` (sourcesFromBuffers of a K = 4 render),
+  // writes denoised.png and, unless a preview, denoised.exr, weights.exr and <member>.exr to
+  // `dir`, and adds every stage's seconds to stats["seconds"] and, with a reference, the
+  // metrics of the noisy input, each member and the result to stats["metrics"].
+  // Returns the seconds of the members and the combiner (without writing).
+  double run(const EnsembleSources& sources, const std::filesystem::path& dir,
+           nlohmann::ordered_json& stats, const Image* reference) const;
+};
+
+}  // namespace chorus::cli

@@ -38,6 +38,7 @@
 #include "renderer/render.h"
 #include "renderer/scene/gltf_loader.h"
 #include "tests/support/synthetic_scene.h"
+#include "tools/sweep/reference_render.h"
 
 namespace chorus::bench {
 namespace {
@@ -112,26 +113,12 @@ std::vector<BenchCase> renderedCases(const BenchOptions& o) {
     options.width = o.renderWidth;
     options.threads = o.threads;
     options.spp = o.referenceSpp;
-    options.seed = 1000;  // independent of the inputs' seed
     const fs::path cached =
         o.referenceCache.empty()
             ? fs::path()
             : fs::path(o.referenceCache) / (spec.name + "-" + std::to_string(o.renderWidth) + "-" +
                                             std::to_string(o.referenceSpp) + "spp.exr");
-    Image reference;
-    if (!cached.empty() && fs::is_regular_file(cached)) {
-      reference = readExrLayer(cached);
-    } else {
-      const auto start = std::chrono::steady_clock::now();
-      reference = render::render(scene, options).buffers.part(BufferPart::Full).color.mean;
-      std::fprintf(stderr, "bench_denoisers: %s reference %d spp in %.1f s\n", spec.name.c_str(),
-                   o.referenceSpp,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-      if (!cached.empty()) {
-        fs::create_directories(cached.parent_path());
-        writeExr(cached, reference);
-      }
-    }
+    const Image reference = sweep::referenceRender(scene, options, cached, "bench_denoisers " + spec.name);
     for (const std::string& spp : splitList(o.spp)) {
       options.spp = std::stoi(spp);
       options.splits = 4;

@@ -9,7 +9,7 @@
 
 #include "denoise/base/filters/pixel_rect.h"
 #include "denoise/base/nlmeans_row_kernels.h"
-#include "denoise/base/padded_planes.h"
+#include "denoise/base/bordered_planes.h"
 #include "denoise/util/float_lanes.h"
 
 namespace chorus {
@@ -87,16 +87,16 @@ class FeatureNlMeansKernel {
   FeatureNlMeansParams params_;
   float refineMinWeight_;
   std::vector<int> dataBegin_;  // first plane of every data image in data_
-  PaddedPlanes data_;
+  BorderedPlanes data_;
   // Patch term.
   bool hasPatch_ = false;
   int f_ = 0, box_ = 0, patchChannels_ = 0;
   bool patchCentreOnly_ = false;
-  PaddedPlanes g_, vn_, vd_;
+  BorderedPlanes g_, vn_, vd_;
   // Feature terms: one plane per channel of every term.
   std::vector<int> termBegin_;
   std::vector<bool> termCentreOnly_;
-  PaddedPlanes fValue_, fNum_, fDen_;
+  BorderedPlanes fValue_, fNum_, fDen_;
 };
 
 FeatureNlMeansKernel::FeatureNlMeansKernel(std::span<const Image* const> data,
@@ -141,12 +141,12 @@ FeatureNlMeansKernel::FeatureNlMeansKernel(std::span<const Image* const> data,
   }
   dataBegin_.push_back(planes);
   dataChannels_ = planes;
-  data_ = PaddedPlanes(width_, height_, planes, pad_);
+  data_ = BorderedPlanes(width_, height_, planes, pad_);
   for (size_t i = 0; i < data.size(); ++i)
     for (int c = 0; c < data[i]->channels(); ++c) data_.set(dataBegin_[i] + c, *data[i], c);
 
   if (hasPatch_) {
-    g_ = vn_ = vd_ = PaddedPlanes(width_, height_, patchChannels_, pad_);
+    g_ = vn_ = vd_ = BorderedPlanes(width_, height_, patchChannels_, pad_);
     for (int c = 0; c < patchChannels_; ++c) {
       g_.set(c, *patch->guide, c);
       vn_.set(c, *patch->variance, c, patch->alpha);
@@ -160,7 +160,7 @@ FeatureNlMeansKernel::FeatureNlMeansKernel(std::span<const Image* const> data,
     channels += t.value->channels();
   }
   termBegin_.push_back(channels);
-  fValue_ = fNum_ = fDen_ = PaddedPlanes(width_, height_, channels, pad_);
+  fValue_ = fNum_ = fDen_ = BorderedPlanes(width_, height_, channels, pad_);
   for (size_t j = 0; j < features.size(); ++j) {
     const FeatureTerm& t = features[j];
     const Image& den = t.normalizingVariance ? *t.normalizingVariance : *t.variance;

@@ -10,7 +10,7 @@
 
 #include "denoise/base/filters/pixel_rect.h"
 #include "denoise/base/nlmeans_row_kernels.h"
-#include "denoise/base/padded_planes.h"
+#include "denoise/base/bordered_planes.h"
 #include "denoise/base/sure.h"
 #include "denoise/util/float_lanes.h"
 
@@ -62,9 +62,9 @@ class CandidateKernel {
   int patch_[kColor];
   float refineMinWeight_;
   Image guide_, variance_;
-  PaddedPlanes b1_, b2_, g_, vn_, vd_;
+  BorderedPlanes b1_, b2_, g_, vn_, vd_;
   // Features: one plane per channel of every feature, its term's channel range.
-  PaddedPlanes fValue_, fNum_, fDen_[2];
+  BorderedPlanes fValue_, fNum_, fDen_[2];
   std::vector<int> termBegin_;
 };
 
@@ -86,7 +86,7 @@ CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& 
   guide_ = Image(width_, height_, 3);
   for (size_t k = 0; k < guide_.size(); ++k)
     guide_.data()[k] = 0.5f * (b1.data()[k] + b2.data()[k]);
-  for (PaddedPlanes* p : {&b1_, &b2_, &g_, &vn_, &vd_}) *p = PaddedPlanes(width_, height_, 3, pad_);
+  for (BorderedPlanes* p : {&b1_, &b2_, &g_, &vn_, &vd_}) *p = BorderedPlanes(width_, height_, 3, pad_);
   for (int c = 0; c < 3; ++c) {
     b1_.set(c, b1, c, 1.0f);
     b2_.set(c, b2, c, 1.0f);
@@ -101,10 +101,10 @@ CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& 
     channels += f.value.channels();
   }
   termBegin_.push_back(channels);
-  fValue_ = PaddedPlanes(width_, height_, channels, pad_);
-  fNum_ = PaddedPlanes(width_, height_, channels, pad_);
+  fValue_ = BorderedPlanes(width_, height_, channels, pad_);
+  fNum_ = BorderedPlanes(width_, height_, channels, pad_);
   const float tau[2] = {params.tauFirstSecond, params.tauThird};
-  for (int set = 0; set < 2; ++set) fDen_[set] = PaddedPlanes(width_, height_, channels, pad_);
+  for (int set = 0; set < 2; ++set) fDen_[set] = BorderedPlanes(width_, height_, channels, pad_);
   const float kf2 = params.kf * params.kf;
   for (size_t j = 0; j < features.size(); ++j) {
     const RdfcFeature& f = features[j];

@@ -17,12 +17,7 @@ class PlanarImage {
         height_(height),
         channels_(channels),
         data_(size_t(width) * size_t(height) * size_t(channels), fill) {}
-  explicit PlanarImage(const Image& image)
-      : PlanarImage(image.width(), image.height(), image.channels()) {
-    const size_t n = pixelCount();
-    for (size_t i = 0; i < n; ++i)
-      for (int c = 0; c < channels_; ++c) plane(c)[i] = image.data()[i * size_t(channels_) + c];
-  }
+  explicit PlanarImage(const Image& image);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -33,14 +28,10 @@ class PlanarImage {
   const float* plane(int c) const { return data_.data() + size_t(c) * pixelCount(); }
   float* row(int c, int y) { return plane(c) + size_t(y) * size_t(width_); }
   const float* row(int c, int y) const { return plane(c) + size_t(y) * size_t(width_); }
+  float& operator()(int x, int y, int c) { return row(c, y)[x]; }
+  float operator()(int x, int y, int c) const { return row(c, y)[x]; }
 
-  Image toImage() const {
-    Image image(width_, height_, channels_);
-    const size_t n = pixelCount();
-    for (size_t i = 0; i < n; ++i)
-      for (int c = 0; c < channels_; ++c) image.data()[i * size_t(channels_) + c] = plane(c)[i];
-    return image;
-  }
+  Image toImage() const;
 
  private:
   int width_ = 0, height_ = 0, channels_ = 0;

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "denoise/base/filters/planar_image.h"
+#include "denoise/image/planar_image.h"
 #include "denoise/base/filters/simd_quad.h"
 
 namespace chorus {

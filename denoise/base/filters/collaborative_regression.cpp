@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "denoise/base/filters/planar_image.h"
+#include "denoise/image/planar_image.h"
 #include "denoise/base/filters/simd_quad.h"
 
 namespace chorus {
@@ -87,7 +87,7 @@ class Regression {
         stride_((side_ * side_ + kLanes - 1) / kLanes * kLanes) {
     for (int j = 0; j < m_; ++j) {
       float* plane = f_.plane(j);
-      for (size_t i = 0; i < f_.planeSize(); ++i)
+      for (size_t i = 0; i < f_.pixelCount(); ++i)
         if (!std::isfinite(plane[i])) plane[i] = 0.0f;
     }
   }

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "denoise/base/filters/planar_image.h"
+#include "denoise/image/planar_image.h"
 
 namespace chorus {
 namespace {

@@ -46,7 +46,7 @@ NlMeansWeights::NlMeansWeights(std::span<const NlMeansTerm> terms, const NlMeans
     t.varianceNum = PlanarImage(v);
     t.varianceDen = PlanarImage(vd);
     const float numScale = term.alpha * term.s, denScale = term.k * term.k * term.s;
-    const size_t n = t.guide.planeSize();
+    const size_t n = t.guide.pixelCount();
     for (int c = 0; c < g.channels(); ++c) {
       float* gp = t.guide.plane(c);
       float* vn = t.varianceNum.plane(c);

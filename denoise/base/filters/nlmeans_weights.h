@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "denoise/base/filters/pixel_rect.h"
-#include "denoise/base/filters/planar_image.h"
+#include "denoise/image/planar_image.h"
 #include "denoise/image/image.h"
 
 namespace chorus {

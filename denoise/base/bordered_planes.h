@@ -1,6 +1,8 @@
 #pragma once
 // Planar float images with a zero border, for the NL-means row kernels (nlmeans_row_kernels.h):
 // a kernel may read any neighbour within `pad` pixels of the image without bounds checks.
+// Unlike PaddedPlanes (denoise/image/padded_planes.h: SIMD-aligned rows with horizontal margins
+// only, for à-trous), the border surrounds the image on all four sides.
 #include <algorithm>
 #include <cstddef>
 #include <vector>
@@ -9,10 +11,10 @@
 
 namespace chorus {
 
-class PaddedPlanes {
+class BorderedPlanes {
  public:
-  PaddedPlanes() = default;
-  PaddedPlanes(int width, int height, int channels, int pad)
+  BorderedPlanes() = default;
+  BorderedPlanes(int width, int height, int channels, int pad)
       : pad_(pad),
         stride_(size_t(width + 2 * pad)),
         planeSize_(stride_ * size_t(height + 2 * pad)),

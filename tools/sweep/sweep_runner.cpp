@@ -1,0 +1,320 @@
+#include "tools/sweep/sweep_runner.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <ostream>
+#include <set>
+
+#include "denoise/base/registry.h"
+#include "denoise/ensemble/ensemble.h"
+#include "denoise/image/exr_io.h"
+#include "denoise/image/false_color.h"
+#include "denoise/image/png_io.h"
+#include "denoise/metrics/metrics.h"
+#include "denoise/util/atomic_file.h"
+#include "denoise/util/error.h"
+#include "renderer/scene/gltf_loader.h"
+#include "tools/sweep/crop_window.h"
+#include "tools/sweep/sweep_directory.h"
+
+namespace chorus::sweep {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Any fixed value other than 0: the reference's samples must differ from the noisy renders'.
+constexpr uint64_t kReferenceSeedOffset = 0x9e3779b97f4a7c15ull;
+constexpr int kProbeSpp = 16;
+
+// Everything a case needs that does not depend on the case: validated once per sweep.
+struct Plan {
+  std::vector<EnsembleMember> members;
+  std::vector<std::string> combos;
+  std::vector<Combiner> combiners;
+  std::set<std::pair<std::string, std::string>> rowKeys;  // (method, combiner) of every row
+  size_t largestCombo = 0;                                // whose ensemble the crops show
+};
+
+Plan makePlan(const SweepConfig& config) {
+  Plan plan;
+  if (config.methods.empty()) throw Error("--methods is empty");
+  for (const std::string& spec : config.methods) {
+    if (std::count(config.methods.begin(), config.methods.end(), spec) > 1)
+      throw Error("--methods lists '" + spec + "' twice");
+    plan.members.push_back({spec, std::shared_ptr<const BaseDenoiser>(createDenoiser(spec))});
+  }
+  plan.combos = planCombinations(config.methods, config.combos);
+  for (const std::string& name : config.combiners) plan.combiners.push_back(parseCombiner(name));
+  plan.rowKeys.insert({"noisy", "-"});
+  for (const std::string& m : config.methods) plan.rowKeys.insert({m, "-"});
+  for (size_t i = 0; i < plan.combos.size(); ++i) {
+    for (Combiner c : plan.combiners)
+      plan.rowKeys.insert({plan.combos[i], std::string(combinerName(c))});
+    if (splitCombination(plan.combos[i]).size() >
+        splitCombination(plan.combos[plan.largestCombo]).size())
+      plan.largestCombo = i;
+  }
+  return plan;
+}
+
+// A case is complete when its table exists and holds exactly the rows this sweep would write
+// (a rerun with other methods or combiners recomputes it rather than mixing configurations).
+bool caseIsComplete(const fs::path& csv, const Plan& plan) {
+  if (!fs::exists(csv)) return false;
+  std::set<std::pair<std::string, std::string>> keys;
+  for (const SweepRow& r : readCsv(csv)) keys.insert({r.method, r.combiner});
+  return keys == plan.rowKeys;
+}
+
+Image readReference(const fs::path& file) {
+  Image image = readExrLayer(file);
+  if (image.channels() == 4) image = image.channelRange(0, 3);
+  if (image.channels() != 3)
+    throw fileError(file, "has " + std::to_string(image.channels()) + " channels, expected RGB");
+  return image;
+}
+
+std::string sizeText(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+// The reference of a scene: the given file, else DIR/references/<scene>.exr, rendered once
+// (K = 1, another seed) when absent. Returns the file it came from.
+fs::path obtainReference(const SweepConfig& config, size_t sceneIndex, const std::string& scene,
+                         const render::Scene& built, Image* reference, SweepRunStats* stats) {
+  if (!config.references.empty()) {
+    *reference = readReference(config.references[sceneIndex]);
+    return config.references[sceneIndex];
+  }
+  const fs::path cached = referencePath(config.out, scene);
+  if (!fs::exists(cached)) {
+    render::RenderOptions options = config.render;
+    options.splits = 1;
+    options.seed = config.render.seed + kReferenceSeedOffset;
+    int spp = config.referenceSpp;
+    if (config.referenceSeconds > 0) {
+      options.spp = kProbeSpp;
+      const double probe = render::render(built, options).stats.renderSeconds;
+      spp = referenceSppFor(spp, config.referenceSeconds, kProbeSpp, probe);
+    }
+    options.spp = spp;
+    if (config.progress)
+      *config.progress << "sweep: rendering the reference of " << scene << " at " << spp << " spp\n"
+                       << std::flush;
+    const render::RenderResult result = render::render(built, options);
+    ensureDirectory(cached.parent_path());
+    writeExr(cached, result.buffers.sub(0).color.mean);
+    ++stats->referencesRendered;
+    if (config.progress)
+      *config.progress << "sweep: reference of " << scene << " done in "
+                       << result.stats.renderSeconds << " s -> " << cached.string() << "\n"
+                       << std::flush;
+  }
+  *reference = readReference(cached);
+  return cached;
+}
+
+SweepRow makeRow(const SweepCase& c, const std::string& method, const std::string& combiner,
+                 int members, const Image& image, const Image& reference, double renderSeconds,
+                 double denoiseSeconds) {
+  const ImageMetrics m = computeMetrics(image, reference);
+  SweepRow row;
+  row.scene = c.scene;
+  row.spp = c.spp;
+  row.method = method;
+  row.combiner = combiner;
+  row.members = members;
+  row.relMse = m.relMse;
+  row.dssim = m.dssim;
+  row.psnr = m.psnr;
+  row.smape = m.smape;
+  row.renderSeconds = renderSeconds;
+  row.denoiseSeconds = denoiseSeconds;
+  row.totalSeconds = renderSeconds + denoiseSeconds;
+  return row;
+}
+
+double stageSeconds(const std::vector<StageTime>& times, const std::string& stage) {
+  for (const StageTime& t : times)
+    if (t.stage == stage) return t.seconds;
+  return 0;
+}
+
+struct CaseResult {
+  std::vector<SweepRow> rows;
+  SceneCrops crops;
+};
+
+CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase& c,
+                   const render::Scene& scene, const Image& reference,
+                   const fs::path& referenceFile) {
+  render::RenderOptions options = config.render;
+  options.spp = c.spp;
+  options.splits = 4;
+  const render::RenderResult render = render::render(scene, options);
+  if (!reference.sameSize(render.buffers.sub(0).color.mean))
+    throw fileError(referenceFile, "is " + sizeText(reference.width(), reference.height()) +
+                                       " but the renders are " +
+                                       sizeText(render.buffers.width(), render.buffers.height()));
+  const double renderSeconds = render.stats.renderSeconds;
+
+  const EnsembleSources sources = sourcesFromBuffers(render.buffers);
+  checkMembersCanRun(sources, plan.members);
+  std::vector<StageTime> times;
+  const std::vector<BaseOutputs> bases = runBaseDenoisers(sources, plan.members, &times);
+  const EnsembleGuides guides = guidesFromSources(sources);
+
+  // Times. A base denoiser alone costs one run on the full buffer (what a user running only it
+  // pays). A combination costs its members' runs on A, B and full plus the combine stages
+  // (solve, filter, blend): the base outputs are shared across combinations here, but a user
+  // running that one ensemble pays all of it. Runs are timed individually, so the figures are
+  // sequential costs even though the sweep runs the bases in parallel.
+  std::map<std::string, const BaseOutputs*> byName;
+  std::map<std::string, double> ensembleCost;  // member → A + B + full seconds
+  for (const BaseOutputs& b : bases) {
+    byName[b.name] = &b;
+    ensembleCost[b.name] = stageSeconds(times, b.name + "/A") + stageSeconds(times, b.name + "/B") +
+                           stageSeconds(times, b.name + "/full");
+  }
+
+  CaseResult result;
+  result.rows.push_back(makeRow(c, "noisy", "-", 0, guides.color, reference, renderSeconds, 0));
+  for (const BaseOutputs& b : bases)
+    result.rows.push_back(makeRow(c, b.name, "-", 1, b.full, reference, renderSeconds,
+                                  stageSeconds(times, b.name + "/full")));
+
+  const CropWindow window = worstWindow(guides.color, reference, config.cropSize);
+  auto cropPng = [&](const Image& image) { return encodePng(cropImage(image, window)); };
+  result.crops.scene = c.scene;
+  result.crops.spp = c.spp;
+  result.crops.images.push_back({"noisy", cropPng(guides.color)});
+  for (const BaseOutputs& b : bases) result.crops.images.push_back({b.name, cropPng(b.full)});
+
+  for (size_t i = 0; i < plan.combos.size(); ++i) {
+    std::vector<const BaseOutputs*> members;
+    double membersSeconds = 0;
+    for (const std::string& m : splitCombination(plan.combos[i])) {
+      members.push_back(byName.at(m));
+      membersSeconds += ensembleCost.at(m);
+    }
+    for (Combiner combiner : plan.combiners) {
+      CombineOptions combineOptions;
+      combineOptions.combiner = combiner;
+      const CombineResult combined =
+          combine(guides, members, combineOptions, needsReference(combiner) ? &reference : nullptr);
+      double seconds = membersSeconds;
+      for (const StageTime& t : combined.times) seconds += t.seconds;
+      result.rows.push_back(makeRow(c, plan.combos[i], std::string(combinerName(combiner)),
+                                    int(members.size()), combined.image, reference, renderSeconds,
+                                    seconds));
+      if (i == plan.largestCombo && combiner == Combiner::Ensemble) {
+        result.crops.images.push_back(
+            {"ensemble (" + plan.combos[i] + ")", cropPng(combined.image)});
+        // The sweep uses the summed MSE form: one weight map per base (channel 0).
+        for (size_t m = 0; m < members.size(); ++m)
+          result.crops.weightMaps.push_back(
+              {members[m]->name, encodePng(falseColor(cropImage(combined.weights[m], window)))});
+      }
+    }
+  }
+  result.crops.images.push_back({"reference", cropPng(reference)});
+  return result;
+}
+
+std::string clockText(double seconds) {
+  const long s = long(seconds + 0.5);
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
+  return buffer;
+}
+
+}  // namespace
+
+int referenceSppFor(int spp, double seconds, int probeSpp, double probeSeconds) {
+  if (seconds <= 0) return spp;
+  const double rate = double(probeSpp) / std::max(probeSeconds, 1e-6);
+  const double budget = std::clamp((seconds - probeSeconds) * rate, double(probeSpp), 1e8);
+  return int(budget);
+}
+
+SweepRunStats runSweep(const SweepConfig& config) {
+  if (config.scenes.empty()) throw Error("no scenes given");
+  if (config.out.empty()) throw Error("no output directory given (--out)");
+  for (const fs::path& scene : config.scenes)
+    if (!fs::is_regular_file(scene)) throw fileError(scene, "no such file");
+  if (!config.references.empty() && config.references.size() != config.scenes.size())
+    throw Error("--reference given " + std::to_string(config.references.size()) + " times for " +
+                std::to_string(config.scenes.size()) + " scenes (one per scene, in scene order)");
+  for (const fs::path& reference : config.references)
+    if (!fs::is_regular_file(reference)) throw fileError(reference, "no such file");
+  if (config.cropSize < 1) throw Error("crop size must be positive");
+  const Plan plan = makePlan(config);
+
+  const std::vector<SweepCase> all = planCases(config.scenes, config.spps);
+  const std::vector<SweepCase> mine = casesOfShard(all, config.shard);
+  SweepRunStats stats;
+  stats.casesPlanned = int(mine.size());
+  std::vector<SweepCase> pending;
+  for (const SweepCase& c : mine)
+    if (caseIsComplete(caseCsvPath(config.out, c), plan))
+      ++stats.casesSkipped;
+    else
+      pending.push_back(c);
+  ensureDirectory(config.out / "cases");
+  if (config.progress)
+    *config.progress << "sweep: " << mine.size() << " case(s) in this shard, " << stats.casesSkipped
+                     << " already done, " << pending.size() << " to run\n"
+                     << std::flush;
+
+  std::function<render::Scene(const fs::path&)> loadScene = config.loadScene;
+  if (!loadScene)
+    loadScene = [&](const fs::path& path) {
+      return render::buildScene(render::loadGltf(path), config.environment);
+    };
+  const auto start = Clock::now();
+  double caseSeconds = 0;
+  for (size_t s = 0; s < config.scenes.size(); ++s) {
+    std::vector<SweepCase> cases;
+    for (const SweepCase& c : pending)
+      if (c.scenePath == config.scenes[s]) cases.push_back(c);
+    if (cases.empty()) continue;
+    const render::Scene scene = loadScene(config.scenes[s]);
+    Image reference;
+    const fs::path referenceFile =
+        obtainReference(config, s, cases[0].scene, scene, &reference, &stats);
+    for (const SweepCase& c : cases) {
+      const auto caseStart = Clock::now();
+      const CaseResult result = runCase(config, plan, c, scene, reference, referenceFile);
+      writeCaseCrops(config.out, c, result.crops);
+      writeCsv(caseCsvPath(config.out, c), result.rows);  // last: marks the case complete
+      stats.ranCases.push_back(c.fileStem());
+      ++stats.casesRun;
+      caseSeconds += secondsSince(caseStart);
+      if (config.progress) {
+        // ETA from the mean case time so far (cases at higher spp take longer: a lower bound
+        // early in a scene, refined as the sweep goes).
+        const double remaining =
+            caseSeconds / stats.casesRun * double(pending.size() - size_t(stats.casesRun));
+        *config.progress << "sweep: [" << stats.casesRun << "/" << pending.size() << "] " << c.scene
+                         << " at " << c.spp << " spp: " << result.rows.size() << " rows, elapsed "
+                         << clockText(secondsSince(start)) << ", ETA " << clockText(remaining)
+                         << "\n"
+                         << std::flush;
+      }
+    }
+  }
+  writeSweepSummary(config.out, config.report);
+  return stats;
+}
+
+}  // namespace chorus::sweep

@@ -1,7 +1,6 @@
 #include "tools/sweep/sweep_runner.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -16,6 +15,7 @@
 #include "denoise/metrics/metrics.h"
 #include "denoise/util/atomic_file.h"
 #include "denoise/util/error.h"
+#include "denoise/util/stopwatch.h"
 #include "renderer/scene/gltf_loader.h"
 #include "tools/sweep/crop_window.h"
 #include "tools/sweep/sweep_directory.h"
@@ -25,12 +25,6 @@ namespace chorus::sweep {
 namespace fs = std::filesystem;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // Any fixed value other than 0: the reference's samples must differ from the noisy renders'.
 constexpr uint64_t kReferenceSeedOffset = 0x9e3779b97f4a7c15ull;
@@ -150,6 +144,18 @@ double stageSeconds(const std::vector<StageTime>& times, const std::string& stag
   return 0;
 }
 
+// One map per base whatever the MSE form (per-channel weights: their mean over channels).
+Image channelMean(const Image& image) {
+  Image mean(image.width(), image.height(), 1);
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x) {
+      float sum = 0;
+      for (int c = 0; c < image.channels(); ++c) sum += image(x, y, c);
+      mean(x, y, 0) = sum / float(image.channels());
+    }
+  return mean;
+}
+
 struct CaseResult {
   std::vector<SweepRow> rows;
   SceneCrops crops;
@@ -208,7 +214,7 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
       membersSeconds += ensembleCost.at(m);
     }
     for (Combiner combiner : plan.combiners) {
-      CombineOptions combineOptions;
+      CombineOptions combineOptions = config.combine;
       combineOptions.combiner = combiner;
       const CombineResult combined =
           combine(guides, members, combineOptions, needsReference(combiner) ? &reference : nullptr);
@@ -220,10 +226,10 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
       if (i == plan.largestCombo && combiner == Combiner::Ensemble) {
         result.crops.images.push_back(
             {"ensemble (" + plan.combos[i] + ")", cropPng(combined.image)});
-        // The sweep uses the summed MSE form: one weight map per base (channel 0).
         for (size_t m = 0; m < members.size(); ++m)
           result.crops.weightMaps.push_back(
-              {members[m]->name, encodePng(falseColor(cropImage(combined.weights[m], window)))});
+              {members[m]->name,
+               encodePng(falseColor(channelMean(cropImage(combined.weights[m], window))))});
       }
     }
   }
@@ -281,7 +287,7 @@ SweepRunStats runSweep(const SweepConfig& config) {
     loadScene = [&](const fs::path& path) {
       return render::buildScene(render::loadGltf(path), config.environment);
     };
-  const auto start = Clock::now();
+  const Stopwatch sweepTime;
   double caseSeconds = 0;
   for (size_t s = 0; s < config.scenes.size(); ++s) {
     std::vector<SweepCase> cases;
@@ -293,13 +299,13 @@ SweepRunStats runSweep(const SweepConfig& config) {
     const fs::path referenceFile =
         obtainReference(config, s, cases[0].scene, scene, &reference, &stats);
     for (const SweepCase& c : cases) {
-      const auto caseStart = Clock::now();
+      const Stopwatch caseTime;
       const CaseResult result = runCase(config, plan, c, scene, reference, referenceFile);
       writeCaseCrops(config.out, c, result.crops);
       writeCsv(caseCsvPath(config.out, c), result.rows);  // last: marks the case complete
       stats.ranCases.push_back(c.fileStem());
       ++stats.casesRun;
-      caseSeconds += secondsSince(caseStart);
+      caseSeconds += caseTime.seconds();
       if (config.progress) {
         // ETA from the mean case time so far (cases at higher spp take longer: a lower bound
         // early in a scene, refined as the sweep goes).
@@ -307,7 +313,7 @@ SweepRunStats runSweep(const SweepConfig& config) {
             caseSeconds / stats.casesRun * double(pending.size() - size_t(stats.casesRun));
         *config.progress << "sweep: [" << stats.casesRun << "/" << pending.size() << "] " << c.scene
                          << " at " << c.spp << " spp: " << result.rows.size() << " rows, elapsed "
-                         << clockText(secondsSince(start)) << ", ETA " << clockText(remaining)
+                         << clockText(sweepTime.seconds()) << ", ETA " << clockText(remaining)
                          << "\n"
                          << std::flush;
       }

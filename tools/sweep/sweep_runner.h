@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "denoise/ensemble/combiners.h"
 #include "renderer/render.h"
 #include "renderer/scene/environment.h"
 #include "tools/sweep/report_html.h"
@@ -39,6 +40,7 @@ struct SweepConfig {
   // Loads and builds a scene; the default is loadGltf + buildScene(environment). The CLI passes
   // its own (warnings on stderr).
   std::function<render::Scene(const std::filesystem::path&)> loadScene;
+  CombineOptions combine;  // solver, MSE form, weight filter (the combiner is set per row)
   int cropSize = 96;
   std::ostream* progress = nullptr;  // progress lines with ETA; nullptr: silent
   ReportInfo report;

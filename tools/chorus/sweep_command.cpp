@@ -1,0 +1,168 @@
+// chorus sweep SCENE... --out DIR: sample-count sweeps of every base denoiser and every
+// combination × combiner against a reference, with results.csv and a self-contained
+// report.html (tools/sweep/). `--merge DIR...` combines the directories of sharded runs.
+#include <tbb/global_control.h>
+
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "denoise/base/registry.h"
+#include "denoise/util/error.h"
+#include "tools/chorus/command.h"
+#include "tools/chorus/ensemble_flags.h"
+#include "tools/chorus/scene_options.h"
+#include "tools/sweep/report_html.h"
+#include "tools/sweep/sweep_directory.h"
+#include "tools/sweep/sweep_runner.h"
+
+namespace chorus::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct SweepArgs {
+  std::vector<std::string> scenes, references, merge;
+  std::string spp = "4,8,16,32,64,128,256", methods, combos = "all";
+  std::string combiners = "ensemble,onehot-pre,onehot-post,average,oracle";
+  std::string out, shard = "0/1";
+  int referenceSpp = 16384;
+  double referenceSeconds = 0;
+  int cropSize = 96;
+  SceneOptions scene;
+  EnsembleFlags ensemble;
+  bool quiet = false;
+};
+
+std::string defaultMethods() {
+  std::string list;
+  for (const DenoiserEntry& entry : builtinDenoisers())
+    list += (list.empty() ? "" : ",") + entry.name;
+  return list;
+}
+
+template <typename T>
+std::string joined(const std::vector<T>& items) {
+  std::ostringstream text;
+  for (size_t i = 0; i < items.size(); ++i) text << (i ? "," : "") << items[i];
+  return text.str();
+}
+
+// The report's "details" line: what was swept and how, so a mailed report explains itself.
+std::string describe(const sweep::SweepConfig& c, const SweepArgs& args) {
+  std::ostringstream text;
+  text << "scenes: " << joined(args.scenes) << "\nspp: " << joined(c.spps)
+       << "; methods: " << joined(c.methods) << "; combos: " << c.combos
+       << "; combiners: " << joined(c.combiners) << "\nreference: "
+       << (!c.references.empty()    ? joined(args.references)
+           : c.referenceSeconds > 0 ? std::to_string(c.referenceSeconds) + " s budget"
+                                    : std::to_string(c.referenceSpp) + " spp")
+       << "; size: " << c.render.width << "x" << c.render.height << " (0: from the camera)"
+       << "; seed " << c.render.seed << "; threads " << c.render.threads << " (0: all)"
+       << "; chorus " << CHORUS_VERSION;
+  return text.str();
+}
+
+void printHeadline(const fs::path& out, const std::vector<sweep::SweepRow>& rows) {
+  std::cout << "wrote " << (out / "results.csv").string() << " (" << rows.size() << " rows) and "
+            << (out / "report.html").string() << "\n";
+  for (const char* other : {"best-member", "onehot-pre", "onehot-post", "average"}) {
+    const sweep::EnsembleWins w = sweep::ensembleWins(rows, other);
+    if (w.cases)
+      std::printf("ensemble beats %s in %.1f%% of %d cases\n", other, w.percent(), w.cases);
+  }
+}
+
+void runMerge(const SweepArgs& args) {
+  if (!args.scenes.empty())
+    throw Error("--merge takes sweep directories, not scenes (got '" + args.scenes[0] + "')");
+  sweep::ReportInfo info;
+  info.details = "merged from: " + joined(args.merge);
+  std::vector<fs::path> inputs(args.merge.begin(), args.merge.end());
+  printHeadline(args.out, sweep::mergeSweeps(args.out, inputs, info));
+}
+
+void runSweepCommand(const SweepArgs& args) {
+  if (!args.merge.empty()) return runMerge(args);
+  if (args.scenes.empty()) throw Error("no scenes given (or --merge DIR... to combine sweeps)");
+  sweep::SweepConfig config;
+  config.scenes.assign(args.scenes.begin(), args.scenes.end());
+  config.spps = sweep::parseIntList(args.spp, "--spp");
+  config.methods = splitMethodList(args.methods.empty() ? defaultMethods() : args.methods);
+  config.combos = args.combos;
+  config.combiners = splitMethodList(args.combiners);
+  config.references.assign(args.references.begin(), args.references.end());
+  config.referenceSpp = args.referenceSpp;
+  config.referenceSeconds = args.referenceSeconds;
+  config.out = args.out;
+  config.shard = sweep::parseShard(args.shard);
+  config.render = args.scene.render;
+  config.environment = args.scene.environment();
+  config.combine = args.ensemble.options();
+  config.cropSize = args.cropSize;
+  config.loadScene = [&](const fs::path& path) {
+    return std::move(loadScene(path.string(), args.scene, args.quiet).scene);
+  };
+  config.progress = args.quiet ? nullptr : &std::cerr;
+  config.report.details = describe(config, args);
+  // Denoisers run on TBB: --threads limits them as it limits the renderer.
+  std::optional<tbb::global_control> threads;
+  if (config.render.threads > 0)
+    threads.emplace(tbb::global_control::max_allowed_parallelism, size_t(config.render.threads));
+
+  const sweep::SweepRunStats stats = sweep::runSweep(config);
+  if (!args.quiet)
+    std::cerr << "sweep: ran " << stats.casesRun << " case(s), " << stats.casesSkipped
+              << " already done, " << stats.referencesRendered << " reference(s) rendered\n";
+  printHeadline(config.out, sweep::readCsv(config.out / "results.csv"));
+}
+
+const RegisterCommand registration(50, [](CLI::App& app) {
+  auto args = std::make_shared<SweepArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "sweep",
+      "Sample-count sweep: per scene and spp, render once (K = 4), run every base denoiser "
+      "once, evaluate every combination with every combiner against a reference; writes "
+      "DIR/results.csv and a self-contained DIR/report.html");
+  cmd->add_option("scenes", args->scenes, "glTF scenes (.gltf or .glb)");
+  cmd->add_option("--out", args->out, "Output directory (reruns resume from it)")->required();
+  cmd->add_option("--spp", args->spp, "Comma-separated samples per pixel")->capture_default_str();
+  cmd->add_option("--methods", args->methods,
+                  "Comma-separated base denoisers (default: every built-in one)");
+  cmd->add_option("--combos", args->combos,
+                  "'all' (every subset of at least two methods), 'none', or a list such as "
+                  "nfor+rdfc,nfor+nlm+atrous")
+      ->capture_default_str();
+  cmd->add_option("--combiners", args->combiners,
+                  "Comma-separated: ensemble, onehot-pre, onehot-post, average, oracle, "
+                  "oracle-unconstrained")
+      ->capture_default_str();
+  cmd->add_option("--reference", args->references,
+                  "Reference EXR, once per scene in scene order (default: rendered into "
+                  "DIR/references/)");
+  cmd->add_option("--reference-spp", args->referenceSpp, "Samples per pixel of rendered references")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--reference-seconds", args->referenceSeconds,
+                  "Render each reference for about this long instead (spp from a 16-spp probe)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--shard", args->shard,
+                  "I/N: run only the cases whose index mod N is I (for job arrays)")
+      ->capture_default_str();
+  cmd->add_option("--merge", args->merge,
+                  "Combine the sweep directories of sharded runs into --out (no scenes)")
+      ->expected(1, -1);
+  cmd->add_option("--crop-size", args->cropSize, "Side of the report's crops, pixels")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  args->scene.addFlags(*cmd);
+  args->ensemble.addFlags(*cmd);
+  cmd->add_flag("--quiet", args->quiet, "No progress lines");
+  cmd->callback([args] { runSweepCommand(*args); });
+});
+
+}  // namespace
+}  // namespace chorus::cli

@@ -245,6 +245,13 @@ document.querySelectorAll('table.sortable').forEach(function (table) {
     });
   });
 });
+// Decoded crops, counted once everything loaded (the browser test checks them too).
+window.addEventListener('load', function () {
+  var decoded = Array.prototype.filter.call(document.images, function (image) {
+    return image.complete && image.naturalWidth > 0;
+  });
+  document.body.setAttribute('data-images-decoded', String(decoded.length));
+});
 document.body.setAttribute('data-report-ready', 'yes');
 )";
 

@@ -190,6 +190,15 @@ TEST(SweepRunner, ReferenceOfTheWrongSizeIsNamed) {
   }
 }
 
+TEST(SweepRunner, ReferenceFromATimeBudget) {
+  test::TempDir dir;
+  SweepConfig config = test::tinySweepConfig(dir.path());
+  config.spps = {4};
+  config.referenceSeconds = 0.2;
+  EXPECT_EQ(runSweep(config).referencesRendered, 1);
+  EXPECT_TRUE(fs::exists(dir / "references" / "cornell-box.exr"));
+}
+
 TEST(SweepRunner, ReferenceSppFromATimeBudget) {
   EXPECT_EQ(referenceSppFor(1024, 0, 16, 0.5), 1024);
   EXPECT_EQ(referenceSppFor(1024, 10.5, 16, 0.5), 320);  // 16 spp per 0.5 s for 10 s

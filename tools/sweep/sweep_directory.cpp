@@ -142,10 +142,11 @@ std::vector<SweepRow> writeSweepSummary(const fs::path& dir, const ReportInfo& i
 
 std::vector<SweepRow> mergeSweeps(const fs::path& out, const std::vector<fs::path>& inputs,
                                   const ReportInfo& info) {
-  ensureDirectory(out);
-  for (const fs::path& input : inputs) {
+  for (const fs::path& input : inputs)
     if (!fs::is_directory(input / "cases"))
       throw fileError(input, "is not a sweep directory (no cases/ folder)");
+  ensureDirectory(out);
+  for (const fs::path& input : inputs) {
     if (fs::equivalent(input, out)) continue;
     copyTree(input / "cases", out / "cases");
     copyTree(input / "references", out / "references");

@@ -18,6 +18,7 @@
 #include "denoise/util/stopwatch.h"
 #include "renderer/scene/gltf_loader.h"
 #include "tools/sweep/crop_window.h"
+#include "tools/sweep/reference_render.h"
 #include "tools/sweep/sweep_directory.h"
 
 namespace chorus::sweep {
@@ -26,8 +27,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Any fixed value other than 0: the reference's samples must differ from the noisy renders'.
-constexpr uint64_t kReferenceSeedOffset = 0x9e3779b97f4a7c15ull;
 constexpr int kProbeSpp = 16;
 
 // Everything a case needs that does not depend on the case: validated once per sweep.
@@ -83,7 +82,7 @@ std::string sizeText(int width, int height) {
 }
 
 // The reference of a scene: the given file, else DIR/references/<scene>.exr, rendered once
-// (K = 1, another seed) when absent. Returns the file it came from.
+// (reference_render.h: K = 1, its own seed) when absent. Returns the file it came from.
 fs::path obtainReference(const SweepConfig& config, size_t sceneIndex, const std::string& scene,
                          const render::Scene& built, Image* reference, SweepRunStats* stats) {
   if (!config.references.empty()) {
@@ -91,30 +90,25 @@ fs::path obtainReference(const SweepConfig& config, size_t sceneIndex, const std
     return config.references[sceneIndex];
   }
   const fs::path cached = referencePath(config.out, scene);
-  if (!fs::exists(cached)) {
-    render::RenderOptions options = config.render;
-    options.splits = 1;
-    options.seed = config.render.seed + kReferenceSeedOffset;
-    int spp = config.referenceSpp;
+  render::RenderOptions options = config.render;
+  options.spp = config.referenceSpp;
+  const bool wasCached = fs::exists(cached);
+  const auto cachedTime = wasCached ? fs::last_write_time(cached) : fs::file_time_type{};
+  if (!wasCached) {
     if (config.referenceSeconds > 0) {
       options.spp = kProbeSpp;
+      options.splits = 1;
       const double probe = render::render(built, options).stats.renderSeconds;
-      spp = referenceSppFor(spp, config.referenceSeconds, kProbeSpp, probe);
+      options.spp = referenceSppFor(config.referenceSpp, config.referenceSeconds, kProbeSpp, probe);
     }
-    options.spp = spp;
     if (config.progress)
-      *config.progress << "sweep: rendering the reference of " << scene << " at " << spp << " spp\n"
-                       << std::flush;
-    const render::RenderResult result = render::render(built, options);
-    ensureDirectory(cached.parent_path());
-    writeExr(cached, result.buffers.sub(0).color.mean);
-    ++stats->referencesRendered;
-    if (config.progress)
-      *config.progress << "sweep: reference of " << scene << " done in "
-                       << result.stats.renderSeconds << " s -> " << cached.string() << "\n"
+      *config.progress << "sweep: rendering the reference of " << scene << " at " << options.spp
+                       << " spp\n"
                        << std::flush;
   }
-  *reference = readReference(cached);
+  *reference = referenceRender(built, options, cached, config.progress ? "sweep" : "");
+  // referenceRender also re-renders a cached reference of another width.
+  if (!wasCached || fs::last_write_time(cached) != cachedTime) ++stats->referencesRendered;
   return cached;
 }
 

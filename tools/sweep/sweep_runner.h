@@ -33,8 +33,8 @@ struct SweepConfig {
   std::filesystem::path out;
   Shard shard;
   // Width, height, seed, threads, depth and camera of every render (spp and splits are set per
-  // render). The reference uses a different seed, so that its error is independent of the
-  // noisy renders (they would otherwise share their first samples).
+  // render). References use their own seed (reference_render.h), so that their error is
+  // independent of the noisy renders'.
   render::RenderOptions render;
   render::EnvironmentDesc environment;
   // Loads and builds a scene; the default is loadGltf + buildScene(environment). The CLI passes

@@ -238,7 +238,13 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
     }
     case Combiner::Oracle:
     case Combiner::OracleUnconstrained: {
-      const MseEstimator estimator = MseEstimator::oracle(guides, bases, *reference, options.mse);
+      // Per pixel and relative: with the truth there is no noise to average over a window, and
+      // dividing each channel by (r² + ε) makes the per-pixel objective exactly the pixel's
+      // relMSE, so the oracle is the best per-pixel blend for the metric the sweeps report.
+      MseOptions oracleMse = options.mse;
+      oracleMse.windowRadius = 0;
+      oracleMse.relative = true;
+      const MseEstimator estimator = MseEstimator::oracle(guides, bases, *reference, oracleMse);
       SimplexQpOptions qp = options.qp;
       nonNegative = qp.nonNegative = options.combiner == Combiner::Oracle;
       SolvedWeights solved = solveWeights(estimator, SolverKind::ActiveSet, qp, options.seed);

@@ -14,7 +14,8 @@
 //   onehot-post           the base with the least raw estimated MSE, then the one-hot maps are
 //                         smoothed with the weight filter and renormalised
 //   oracle                like the ensemble but with the true error matrix (needs a reference):
-//                         per-pixel optimal weights on the simplex, not filtered
+//                         per-pixel weights on the simplex minimising the pixel's relMSE (no
+//                         window, each channel divided by r² + ε), not filtered
 //   oracle-unconstrained  the same with only Σw = 1 (weights may be negative)
 #include <cstdint>
 #include <span>

@@ -10,7 +10,8 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
       ->capture_default_str();
   cmd.add_option("--weight-filter", weightFilter,
                  "bilateral (joint bilateral on normal, albedo and the blend, radius 7) or none")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->each([this](const std::string&) { weightFilterGiven = true; });
   cmd.add_option("--mse", mseForm,
                  "MSE matrix per-channel (one weight per colour channel) or summed (one per pixel)")
       ->capture_default_str();

@@ -15,6 +15,8 @@ struct EnsembleFlags {
   bool relative = MseOptions{}.relative;
   uint64_t seed = 1;
 
+  bool weightFilterGiven = false;  // --weight-filter was on the command line
+
   void addFlags(CLI::App& cmd);
   // Throws chorus::Error for an unknown value.
   CombineOptions options() const;

@@ -42,6 +42,7 @@ struct RenderArgs {
 DenoiseStage denoiseStageOf(const RenderArgs& args) {
   CombineOptions options = args.ensemble.options();
   options.combiner = parseCombiner(args.combine);
+  if (args.preview && !args.ensemble.weightFilterGiven) options.filter.enabled = false;
   const std::string list = args.denoiseGiven ? args.denoise : args.preview ? "preview" : "default";
   DenoiseStage stage = DenoiseStage::parse(list, options, !args.preview);
   if (stage.enabled() && args.splits != 0 && args.splits != 4)
@@ -173,7 +174,8 @@ const RegisterCommand registration(30, [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--preview", args->preview,
                 std::string("Fast preview: 4 spp unless --spp, members ") + kPreviewDenoise +
-                    " unless --denoise, writes only denoised.png and stats.json");
+                    " unless --denoise, no weight filter unless --weight-filter, writes only "
+                    "denoised.png and stats.json");
   cmd->add_option("--reference", args->reference,
                   "Reference image (.exr) of the same view: metrics of the noisy input, each "
                   "member and the result in stats.json");

@@ -19,12 +19,11 @@ constexpr uint64_t hashCombine(uint64_t h, uint64_t v) {
   return mix64(h ^ (v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2)));
 }
 
-inline uint32_t reverseBits(uint32_t x) {
+constexpr uint32_t reverseBits(uint32_t x) {
   x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
   x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
   x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
-  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
-  return (x >> 16) | (x << 16);
+  return __builtin_bswap32(x);  // the byte order: one instruction instead of two shift steps
 }
 
 // A seeded permutation of 32-bit words in which output bit k depends only on input bits 0..k
@@ -42,10 +41,6 @@ inline uint32_t lowerBitsPermutation(uint32_t x, uint32_t seed) {
   return x;
 }
 
-// Owen scrambling of a 32-bit binary fraction (most significant bit = first digit).
-inline uint32_t nestedUniformScramble(uint32_t x, uint32_t seed) {
-  return reverseBits(lowerBitsPermutation(reverseBits(x), seed));
-}
 
 // Generator matrix columns of the second Sobol dimension (primitive polynomial x + 1):
 // v_0 = 1/2, v_k = v_{k-1} xor (v_{k-1} / 2). The first dimension is the van der Corput
@@ -71,13 +66,27 @@ constexpr SobolByteTable makeSobolByteTable() {
 }
 constexpr SobolByteTable kSobolDimension1 = makeSobolByteTable();
 
-inline uint32_t sobolDimension0(uint32_t index) {
-  return reverseBits(index);
+// Owen scrambling of a binary fraction v is reverseBits(lowerBitsPermutation(reverseBits(v), s)).
+// The draws below keep words bit-reversed between steps so that the reversals of successive
+// scrambles and of the van der Corput sequence cancel: bit-identical to scrambling the textbook
+// points, with 3 (get2D) and 2 (get1D) reversals instead of 7 and 5 (the sampler was a fifth of
+// the render time).
+//
+// reverseBits(sobolDimension1(reverseBits(z))), a byte of z at a time: byte b of z is byte
+// 3 − b of reverseBits(z), with its bits reversed.
+constexpr SobolByteTable makeReversedSobolByteTable() {
+  SobolByteTable table{};
+  for (int b = 0; b < 4; ++b)
+    for (uint32_t x = 0; x < 256; ++x)
+      table[size_t(b)][x] =
+          reverseBits(kSobolDimension1[size_t(3 - b)][reverseBits(x) >> 24]);
+  return table;
 }
+constexpr SobolByteTable kReversedSobolDimension1 = makeReversedSobolByteTable();
 
-inline uint32_t sobolDimension1(uint32_t index) {
-  return kSobolDimension1[0][index & 0xffu] ^ kSobolDimension1[1][(index >> 8) & 0xffu] ^
-         kSobolDimension1[2][(index >> 16) & 0xffu] ^ kSobolDimension1[3][index >> 24];
+inline uint32_t reversedSobolDimension1(uint32_t z) {
+  return kReversedSobolDimension1[0][z & 0xffu] ^ kReversedSobolDimension1[1][(z >> 8) & 0xffu] ^
+         kReversedSobolDimension1[2][(z >> 16) & 0xffu] ^ kReversedSobolDimension1[3][z >> 24];
 }
 
 // The top 24 bits as a float in [0, 1): exact, and never rounds up to 1.
@@ -91,7 +100,7 @@ void Sampler::startPixelSample(int px, int py, uint32_t indexInSubBuffer, int su
   uint64_t h = hashCombine(mix64(seed_), uint64_t(uint32_t(px)));
   h = hashCombine(h, uint64_t(uint32_t(py)));
   pixelHash_ = hashCombine(h, uint64_t(uint32_t(subBuffer)));
-  index_ = indexInSubBuffer;
+  reversedIndex_ = reverseBits(indexInSubBuffer);
   dimension_ = 0;
 }
 
@@ -102,17 +111,19 @@ Vec2f Sampler::get2D() {
   const uint64_t h = hashCombine(pixelHash_, dimension_);
   dimension_ += 2;
   const uint64_t h2 = mix64(h);
-  const uint32_t shuffled = nestedUniformScramble(index_, uint32_t(h));
-  const uint32_t x = nestedUniformScramble(sobolDimension0(shuffled), uint32_t(h >> 32));
-  const uint32_t y = nestedUniformScramble(sobolDimension1(shuffled), uint32_t(h2));
+  // shuffled index i = reverseBits(z); dimension 0 of i is reverseBits(i) = z, whose scramble
+  // is reverseBits(lowerBitsPermutation(reverseBits(z), ·)); dimension 1 likewise.
+  const uint32_t z = lowerBitsPermutation(reversedIndex_, uint32_t(h));
+  const uint32_t x = reverseBits(lowerBitsPermutation(reverseBits(z), uint32_t(h >> 32)));
+  const uint32_t y = reverseBits(lowerBitsPermutation(reversedSobolDimension1(z), uint32_t(h2)));
   return {toUnitFloat(x), toUnitFloat(y)};
 }
 
 float Sampler::get1D() {
   const uint64_t h = hashCombine(pixelHash_, dimension_);
   dimension_ += 1;
-  const uint32_t shuffled = nestedUniformScramble(index_, uint32_t(h));
-  return toUnitFloat(nestedUniformScramble(sobolDimension0(shuffled), uint32_t(h >> 32)));
+  const uint32_t z = lowerBitsPermutation(reversedIndex_, uint32_t(h));
+  return toUnitFloat(reverseBits(lowerBitsPermutation(reverseBits(z), uint32_t(h >> 32))));
 }
 
 Vec2f Sampler::getPixel2D() {

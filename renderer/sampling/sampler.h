@@ -29,7 +29,7 @@ class Sampler {
  private:
   uint64_t seed_;
   uint64_t pixelHash_ = 0;  // hash of (seed, pixel, sub-buffer)
-  uint32_t index_ = 0;
+  uint32_t reversedIndex_ = 0;  // the sample's index in its sub-buffer, bits reversed
   uint32_t dimension_ = 0;
 };
 

@@ -6,13 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <iostream>
-#include <limits>
 
-#include "denoise/base/registry.h"
-#include "denoise/buffers/tungsten_dir.h"
-#include "denoise/image/exr_io.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
 #include "tests/support/denoiser_checks.h"
 #include "tests/support/synthetic_scene.h"
 #include "tests/support/test_support.h"
@@ -20,27 +15,16 @@
 namespace chorus {
 namespace {
 
-test::SyntheticScene scene64(const test::SyntheticSceneOptions& extra = {}) {
-  test::SyntheticSceneOptions o = extra;
-  o.width = o.height = 64;
-  return test::makeSyntheticScene(o);
-}
-
 // Documented in README.md (à-trous): measured relMSE 0.053 → 0.0054 (9.8×) at 64×64, 16 spp.
 constexpr double kMinImprovement = 5.0;
 
 TEST(Atrous, ReducesRelMseOnTheSyntheticScene) {
-  const test::SyntheticScene scene = scene64();
-  const DenoiseInput input = scene.fullInput();
-  const double noisy = relMse(input.whole.color.mean, scene.truth);
-  const double denoised = relMse(Atrous().run(input), scene.truth);
-  std::cout << "relMSE noisy " << noisy << ", atrous " << denoised << "\n";
-  EXPECT_LT(denoised * kMinImprovement, noisy);
+  test::expectReducesRelMse(Atrous(), kMinImprovement);
 }
 
 TEST(Atrous, DemodulationHelpsOnTheTexturedScene) {
   // The default (demodulate = true) was chosen by this measurement; see README.md.
-  const test::SyntheticScene scene = scene64();
+  const test::SyntheticScene scene = test::syntheticScene(64);
   AtrousParams plain;
   plain.demodulate = false;
   const double withAlbedo = relMse(Atrous().run(scene.fullInput()), scene.truth);
@@ -50,46 +34,21 @@ TEST(Atrous, DemodulationHelpsOnTheTexturedScene) {
 }
 
 TEST(Atrous, KeepsFeatureEdgesSharp) {
-  const test::SyntheticScene scene = scene64();
-  const DenoiseInput input = scene.fullInput();
-  const Image out = Atrous().run(input);
-  const double noisyEdges = test::maskedRelMse(input.whole.color.mean, scene.truth, scene.edgeMask);
-  const double edges = test::maskedRelMse(out, scene.truth, scene.edgeMask);
-  const double blurEdges = test::maskedRelMse(test::gaussianBlur(input.whole.color.mean, 2.0f),
-                                              scene.truth, scene.edgeMask);
-  std::cout << "edge relMSE noisy " << noisyEdges << ", atrous " << edges << ", blur " << blurEdges
-            << "\n";
-  EXPECT_LT(edges * 2.0, noisyEdges);
-  EXPECT_LT(edges * 10.0, blurEdges);
+  test::expectKeepsFeatureEdgesSharp(Atrous(), 2.0, 2.0f, 10.0);
 }
 
 TEST(Atrous, ConstantStaysConstantAndBlackStaysBlack) {
-  for (const std::array<float, 3> value :
-       {std::array<float, 3>{0.3f, 1.5f, 7.0f}, std::array<float, 3>{0.0f, 0.0f, 0.0f}}) {
-    test::SyntheticSceneOptions o;
-    o.constantColor = value;
-    const test::SyntheticScene scene = scene64(o);
-    for (bool demodulate : {true, false}) {
-      AtrousParams params;
-      params.demodulate = demodulate;
-      const Image out = Atrous(params).run(scene.fullInput());
-      EXPECT_LE(test::maxDeviationFrom(out, value.data()), 1e-5f * value[2])
-          << value[2] << " demodulate " << demodulate;
-    }
+  for (bool demodulate : {true, false}) {
+    SCOPED_TRACE(demodulate ? "demodulated" : "not demodulated");
+    AtrousParams params;
+    params.demodulate = demodulate;
+    test::expectConstantStaysConstant(Atrous(params), 1e-5f);
+    test::expectBlackStaysBlack(Atrous(params));
   }
 }
 
 TEST(Atrous, RunsOnEveryBufferPart) {
-  const test::SyntheticScene scene = scene64();
-  for (BufferPart part : {BufferPart::HalfA, BufferPart::HalfB, BufferPart::Full}) {
-    DenoiseInput input = scene.buffers.input(part);
-    input.halves.reset();
-    const Image out = Atrous().run(input);
-    ASSERT_EQ(out.width(), 64);
-    EXPECT_EQ(test::firstNonFinite(out), "");
-    EXPECT_LT(relMse(out, scene.truth) * 4, relMse(input.whole.color.mean, scene.truth))
-        << partName(part);
-  }
+  test::expectRunsOnEveryBufferPart(Atrous(), /*withHalves=*/false, 4);
 }
 
 // Widths that leave interior pixels for every vector width and odd remainders.
@@ -107,10 +66,7 @@ test::SyntheticScene oddScene(bool unknownNormals) {
 }
 
 TEST(Atrous, DeterministicForAnyThreadCount) {
-  const test::SyntheticScene scene = oddScene(false);
-  const Atrous atrous;
-  EXPECT_TRUE(test::bitIdentical(test::runWithThreads(atrous, scene.fullInput(), 1),
-                                 test::runWithThreads(atrous, scene.fullInput(), 2)));
+  test::expectDeterministicAcrossThreads(Atrous(), oddScene(false));
 }
 
 TEST(Atrous, VectorKernelsMatchTheScalarKernelBitForBit) {
@@ -133,7 +89,7 @@ TEST(Atrous, VectorKernelsMatchTheScalarKernelBitForBit) {
 // A light seen directly, recorded as in the chorus renderer: black albedo, bright colour, and a
 // row of pixels mixing light and wall samples (mid albedo, huge variance) below it.
 TEST(Atrous, DemodulationDoesNotLeakEmittersWithBlackAlbedo) {
-  const test::SyntheticScene scene = scene64();
+  const test::SyntheticScene scene = test::syntheticScene(64);
   DenoiseInput input = scene.fullInput();
   Image truth = scene.truth;
   SubBuffer& b = input.whole;
@@ -163,23 +119,23 @@ TEST(Atrous, DemodulationDoesNotLeakEmittersWithBlackAlbedo) {
 }
 
 TEST(Atrous, NonFiniteInputsGiveFiniteOutputs) {
-  const test::SyntheticScene scene = scene64();
-  DenoiseInput input = scene.fullInput();
-  const float nan = std::numeric_limits<float>::quiet_NaN(),
-              inf = std::numeric_limits<float>::infinity();
-  for (int x = 0; x < 64; ++x) {
-    input.whole.albedo.mean(x, 10, 1) = nan;
-    input.whole.depth.mean(x, 20, 0) = inf;
-    input.whole.normal.mean(x, 30, 0) = nan;
-  }
-  input.whole.color.mean(5, 5, 0) = nan;
-  input.whole.color.mean(6, 5, 0) = inf;
-  input.whole.color.varianceOfMean(6, 6, 1) = inf;
-  input.whole.color.varianceOfMean(7, 6, 1) = nan;
+  const auto corrupt = [](DenoiseInput& input) {
+    SubBuffer& b = input.whole;
+    for (int x = 0; x < 64; ++x) {
+      b.albedo.mean(x, 10, 1) = test::kNan;
+      b.depth.mean(x, 20, 0) = test::kInf;
+      b.normal.mean(x, 30, 0) = test::kNan;
+    }
+    b.color.mean(5, 5, 0) = test::kNan;
+    b.color.mean(6, 5, 0) = test::kInf;
+    b.color.varianceOfMean(6, 6, 1) = test::kInf;
+    b.color.varianceOfMean(7, 6, 1) = test::kNan;
+  };
   for (bool clamp : {false, true}) {
+    SCOPED_TRACE(clamp ? "clamped" : "not clamped");
     AtrousParams params;
     params.clampFireflies = clamp;
-    EXPECT_EQ(test::firstNonFinite(Atrous(params).run(input)), "") << "clamp " << clamp;
+    test::expectFiniteOnNonFiniteInputs(Atrous(params), test::syntheticScene(64), corrupt);
   }
 }
 
@@ -187,7 +143,7 @@ TEST(Atrous, FireflyClampMeasurement) {
   // The clamp is a preview option, off by default; this records what it does with fireflies.
   test::SyntheticSceneOptions o;
   o.fireflyProbability = 0.002f;
-  const test::SyntheticScene scene = scene64(o);
+  const test::SyntheticScene scene = test::syntheticScene(64, o);
   AtrousParams clamped;
   clamped.clampFireflies = true;
   const double plain = relMse(Atrous().run(scene.fullInput()), scene.truth);
@@ -195,42 +151,30 @@ TEST(Atrous, FireflyClampMeasurement) {
   std::cout << "with fireflies: relMSE noisy "
             << relMse(scene.fullInput().whole.color.mean, scene.truth) << ", atrous " << plain
             << ", clamped " << withClamp << "\n";
-  const test::SyntheticScene clean = scene64();
+  const test::SyntheticScene clean = test::syntheticScene(64);
   std::cout << "without fireflies: atrous " << relMse(Atrous().run(clean.fullInput()), clean.truth)
             << ", clamped " << relMse(Atrous(clamped).run(clean.fullInput()), clean.truth) << "\n";
   EXPECT_EQ(test::firstNonFinite(Atrous(clamped).run(scene.fullInput())), "");
 }
 
 TEST(Atrous, RegistryAndParameters) {
-  const auto atrous = createDenoiser("atrous:iterations=3:sigmaN=64:demodulate=false");
-  EXPECT_EQ(atrous->name(), "atrous");
-  EXPECT_TRUE(atrous->requirements().features);
-  EXPECT_FALSE(atrous->requirements().halves);
-  EXPECT_THROW(createDenoiser("atrous:sigmaN=100"), Error);
-  EXPECT_THROW(createDenoiser("atrous:iterations=-1"), Error);
-  EXPECT_THROW(createDenoiser("atrous:sigmaL=0"), Error);
+  test::expectCreates("atrous:iterations=3:sigmaN=64:demodulate=false", "atrous",
+                      {.features = true, .halves = false});
+  test::expectRejected({"atrous:sigmaN=100", "atrous:iterations=-1", "atrous:sigmaL=0"});
   // Zero iterations: the input, exactly (demodulation off).
-  const test::SyntheticScene scene = scene64();
-  const Image out = createDenoiser("atrous:iterations=0:demodulate=false")->run(scene.fullInput());
-  EXPECT_TRUE(test::bitIdentical(out, scene.fullInput().whole.color.mean));
+  test::expectIdentity("atrous:iterations=0:demodulate=false");
 }
 
 TEST(Atrous, TungstenPeerBuffers) {
   CHORUS_REQUIRE_SHARED(shared);
-  for (const char* name : {"room", "glossy"}) {
-    const auto dir = shared / "peers/tungsten-nfor" / name;
-    const DenoiseInput input = readTungstenDirectory(dir / "spp4");
-    const Image reference = readExrLayer(dir / "reference.exr");
-    const Image out = Atrous().run(input);
-    ASSERT_EQ(test::firstNonFinite(out), "") << name;
-    const double noisy = relMse(input.whole.color.mean, reference),
-                 denoised = relMse(out, reference);
-    AtrousParams clamped;
-    clamped.clampFireflies = true;
-    std::cout << name << " spp4: relMSE noisy " << noisy << ", atrous " << denoised << ", clamped "
-              << relMse(Atrous(clamped).run(input), reference) << "\n";
-    EXPECT_LT(denoised * 2, noisy) << name;
-  }
+  AtrousParams clamped;
+  clamped.clampFireflies = true;
+  test::expectHalvesTungstenPeerRelMse(
+      Atrous(), shared,
+      [&](const std::string& name, const DenoiseInput& input, const Image& reference) {
+        std::cout << name << " spp4: clamped " << relMse(Atrous(clamped).run(input), reference)
+                  << "\n";
+      });
 }
 
 }  // namespace

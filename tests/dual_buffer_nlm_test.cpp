@@ -6,11 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <iostream>
-#include <limits>
 
-#include "denoise/base/registry.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
 #include "tests/support/denoiser_checks.h"
 #include "tests/support/synthetic_scene.h"
 #include "tests/support/test_support.h"
@@ -18,35 +15,15 @@
 namespace chorus {
 namespace {
 
-test::SyntheticScene scene64(const test::SyntheticSceneOptions& extra = {}) {
-  test::SyntheticSceneOptions o = extra;
-  o.width = o.height = 64;
-  return test::makeSyntheticScene(o);
-}
-
 TEST(DualBufferNlm, ReducesRelMseOnEveryBufferPart) {
-  for (int samples : {1, 4}) {  // 1: each quarter holds one sample (4 spp in total)
-    test::SyntheticSceneOptions o;
-    o.samplesPerSubBuffer = samples;
-    const test::SyntheticScene scene = scene64(o);
-    for (BufferPart part : {BufferPart::HalfA, BufferPart::HalfB, BufferPart::Full}) {
-      const DenoiseInput input = scene.buffers.input(part);
-      const Image out = DualBufferNlMeans().run(input);
-      ASSERT_EQ(test::firstNonFinite(out), "") << partName(part);
-      const double noisy = relMse(input.whole.color.mean, scene.truth);
-      const double denoised = relMse(out, scene.truth);
-      std::cout << samples << " sample(s) per quarter, " << partName(part) << ": relMSE noisy "
-                << noisy << ", nlm " << denoised << "\n";
-      // Measured: 1.5–2.5× with one sample per quarter (colour-only weights from a one-sample
-      // guide), 4–5× with four.
-      EXPECT_LT(denoised * (samples == 1 ? 1.4 : 3.0), noisy) << partName(part) << ", " << samples;
-    }
-  }
+  // Measured: 1.5–2.5× with one sample per quarter (colour-only weights from a one-sample
+  // guide), 4–5× with four.
+  test::expectReducesRelMseOnEveryBufferPart(DualBufferNlMeans(), 1.4, 3.0);
 }
 
 TEST(DualBufferNlm, RandomSamplingPathAlsoDenoises) {
   // The synthetic scene samples independently at random, the case of sampling=random.
-  const test::SyntheticScene scene = scene64();
+  const test::SyntheticScene scene = test::syntheticScene(64);
   const DenoiseInput input = scene.fullInput();
   DualBufferNlMeansParams params;
   params.sampling = "random";
@@ -55,58 +32,38 @@ TEST(DualBufferNlm, RandomSamplingPathAlsoDenoises) {
 }
 
 TEST(DualBufferNlm, ConstantStaysConstantAndBlackStaysBlack) {
-  for (const std::array<float, 3> value :
-       {std::array<float, 3>{0.3f, 1.5f, 7.0f}, std::array<float, 3>{0.0f, 0.0f, 0.0f}}) {
-    test::SyntheticSceneOptions o;
-    o.constantColor = value;
-    const test::SyntheticScene scene = scene64(o);
-    const Image out = DualBufferNlMeans().run(scene.fullInput());
-    EXPECT_LE(test::maxDeviationFrom(out, value.data()), 1e-5f * value[2]) << value[2];
-  }
+  test::expectConstantStaysConstant(DualBufferNlMeans(), 1e-5f);
+  test::expectBlackStaysBlack(DualBufferNlMeans());
 }
 
 TEST(DualBufferNlm, DeterministicForAnyThreadCount) {
-  test::SyntheticSceneOptions o;
-  o.width = 150;  // three filter tiles per row
-  o.height = 40;
-  const test::SyntheticScene scene = test::makeSyntheticScene(o);
-  const DualBufferNlMeans nlm;
-  EXPECT_TRUE(test::bitIdentical(test::runWithThreads(nlm, scene.fullInput(), 1),
-                                 test::runWithThreads(nlm, scene.fullInput(), 2)));
+  // 150 wide: three filter tiles per row.
+  test::expectDeterministicAcrossThreads(DualBufferNlMeans(), test::syntheticScene(150, 40));
 }
 
 TEST(DualBufferNlm, NonFiniteAndExtremeInputsGiveFiniteOutputs) {
   test::SyntheticSceneOptions o;
   o.fireflyProbability = 0.02f;
   o.fireflyScale = 1e5f;
-  const test::SyntheticScene scene = scene64(o);
-  DenoiseInput input = scene.fullInput();
-  const float nan = std::numeric_limits<float>::quiet_NaN(),
-              inf = std::numeric_limits<float>::infinity();
-  SubBuffer& a = input.halves->at(0);
-  for (int x = 0; x < 64; ++x) {
-    a.color.varianceOfMean(x, 10, 1) = nan;
-    input.halves->at(1).color.varianceOfMean(x, 11, 1) = inf;
-    a.sampleCount(x, 12, 0) = 0;
-  }
-  a.color.mean(5, 5, 0) = nan;
-  a.color.mean(6, 5, 1) = inf;
-  input.halves->at(1).color.mean(30, 30, 0) = 1e30f;
-  EXPECT_EQ(test::firstNonFinite(DualBufferNlMeans().run(input)), "");
+  const test::SyntheticScene scene = test::syntheticScene(64, o);
+  test::expectFiniteOnNonFiniteInputs(DualBufferNlMeans(), scene, [](DenoiseInput& input) {
+    SubBuffer &a = input.halves->at(0), &b = input.halves->at(1);
+    for (int x = 0; x < 64; ++x) {
+      a.color.varianceOfMean(x, 10, 1) = test::kNan;
+      b.color.varianceOfMean(x, 11, 1) = test::kInf;
+      a.sampleCount(x, 12, 0) = 0;
+    }
+    a.color.mean(5, 5, 0) = test::kNan;
+    a.color.mean(6, 5, 1) = test::kInf;
+    b.color.mean(30, 30, 0) = 1e30f;
+  });
 }
 
 TEST(DualBufferNlm, RequirementsRegistryAndParameters) {
-  const auto nlm = createDenoiser("nlm:r=7:k=0.5:alpha=0.5:sampling=random");
-  EXPECT_EQ(nlm->name(), "nlm");
-  EXPECT_FALSE(nlm->requirements().features);
-  EXPECT_TRUE(nlm->requirements().halves);
-  EXPECT_THROW(createDenoiser("nlm:window=3"), Error);
-  EXPECT_THROW(createDenoiser("nlm:k=-1"), Error);
-  EXPECT_THROW(createDenoiser("nlm:sampling=sobol"), Error);
-  const test::SyntheticScene scene = scene64();
-  DenoiseInput input = scene.fullInput();
-  input.halves.reset();
-  EXPECT_THROW(DualBufferNlMeans().run(input), Error);
+  test::expectCreates("nlm:r=7:k=0.5:alpha=0.5:sampling=random", "nlm",
+                      {.features = false, .halves = true});
+  test::expectRejected({"nlm:window=3", "nlm:k=-1", "nlm:sampling=sobol"});
+  test::expectNeedsHalves(DualBufferNlMeans());
 }
 
 }  // namespace

@@ -7,12 +7,9 @@
 
 #include <cmath>
 #include <iostream>
-#include <limits>
 
-#include "denoise/base/registry.h"
 #include "denoise/base/variance_estimates.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
 #include "tests/support/denoiser_checks.h"
 #include "tests/support/synthetic_scene.h"
 #include "tests/support/test_support.h"
@@ -20,52 +17,19 @@
 namespace chorus {
 namespace {
 
-test::SyntheticScene scene64(const test::SyntheticSceneOptions& extra = {}) {
-  test::SyntheticSceneOptions o = extra;
-  o.width = o.height = 64;
-  return test::makeSyntheticScene(o);
-}
-
 TEST(Nfor, ReducesRelMseAndKeepsEdges) {
-  const test::SyntheticScene scene = scene64();
-  const DenoiseInput input = scene.fullInput();
-  const Image out = NforDenoiser().run(input);
-  ASSERT_EQ(test::firstNonFinite(out), "");
-  const double noisy = relMse(input.whole.color.mean, scene.truth);
-  const double denoised = relMse(out, scene.truth);
-  const double noisyEdges = test::maskedRelMse(input.whole.color.mean, scene.truth, scene.edgeMask);
-  const double edges = test::maskedRelMse(out, scene.truth, scene.edgeMask);
-  const double blurEdges = test::maskedRelMse(test::gaussianBlur(input.whole.color.mean, 2.0f),
-                                              scene.truth, scene.edgeMask);
-  std::cout << "relMSE noisy " << noisy << ", nfor " << denoised << "; edges noisy " << noisyEdges
-            << ", nfor " << edges << ", blur " << blurEdges << "\n";
-  EXPECT_LT(denoised * 8, noisy);
-  EXPECT_LT(edges * 3, noisyEdges);
-  EXPECT_LT(edges * 3, blurEdges);
+  test::expectReducesRelMse(NforDenoiser(), 8);
+  test::expectKeepsFeatureEdgesSharp(NforDenoiser(), 3, 2.0f, 3);
 }
 
 TEST(Nfor, RunsOnEveryBufferPartIncludingSingleSampleQuarters) {
-  for (int samples : {1, 4}) {  // 1: each quarter holds one sample (4 spp in total)
-    test::SyntheticSceneOptions o;
-    o.samplesPerSubBuffer = samples;
-    const test::SyntheticScene scene = scene64(o);
-    for (BufferPart part : {BufferPart::HalfA, BufferPart::HalfB, BufferPart::Full}) {
-      const DenoiseInput input = scene.buffers.input(part);
-      const Image out = NforDenoiser().run(input);
-      ASSERT_EQ(test::firstNonFinite(out), "") << partName(part);
-      const double noisy = relMse(input.whole.color.mean, scene.truth);
-      const double denoised = relMse(out, scene.truth);
-      std::cout << samples << " sample(s) per quarter, " << partName(part) << ": relMSE noisy "
-                << noisy << ", nfor " << denoised << "\n";
-      EXPECT_LT(denoised * 3, noisy) << partName(part) << ", " << samples;
-    }
-  }
+  test::expectReducesRelMseOnEveryBufferPart(NforDenoiser(), 3, 3);
 }
 
 TEST(Nfor, SingleSampleHalvesFallBackToTheTwoBufferVariance) {
   test::SyntheticSceneOptions o;
   o.samplesPerSubBuffer = 1;
-  const test::SyntheticScene scene = scene64(o);
+  const test::SyntheticScene scene = test::syntheticScene(64, o);
   // On half A at 4 spp the halves are quarters with one sample: their own variance is 0.
   const DenoiseInput input = scene.buffers.input(BufferPart::HalfA);
   ASSERT_EQ(input.halves->at(0).sampleCount(3, 3, 0), 1.0f);
@@ -86,71 +50,52 @@ TEST(Nfor, SingleSampleHalvesFallBackToTheTwoBufferVariance) {
 }
 
 TEST(Nfor, ConstantStaysConstantAndBlackStaysBlack) {
-  for (const std::array<float, 3> value :
-       {std::array<float, 3>{0.3f, 1.5f, 7.0f}, std::array<float, 3>{0.0f, 0.0f, 0.0f}}) {
-    test::SyntheticSceneOptions o;
-    o.constantColor = value;
-    const test::SyntheticScene scene = scene64(o);
-    const Image out = NforDenoiser().run(scene.fullInput());
-    EXPECT_LE(test::maxDeviationFrom(out, value.data()), 1e-4f * value[2]) << value[2];
-  }
+  test::expectConstantStaysConstant(NforDenoiser(), 1e-4f);
+  test::expectBlackStaysBlack(NforDenoiser());
 }
 
 TEST(Nfor, DeterministicForAnyThreadCount) {
+  // 90 wide: three regression tiles per row.
   test::SyntheticSceneOptions o;
-  o.width = 90;  // three regression tiles per row
-  o.height = 40;
   o.fireflyProbability = 0.01f;
-  const test::SyntheticScene scene = test::makeSyntheticScene(o);
-  const NforDenoiser nfor;
-  EXPECT_TRUE(test::bitIdentical(test::runWithThreads(nfor, scene.fullInput(), 1),
-                                 test::runWithThreads(nfor, scene.fullInput(), 2)));
+  test::expectDeterministicAcrossThreads(NforDenoiser(), test::syntheticScene(90, 40, o));
 }
 
 TEST(Nfor, NonFiniteAndExtremeInputsGiveFiniteOutputs) {
   test::SyntheticSceneOptions o;
   o.fireflyProbability = 0.02f;
   o.fireflyScale = 1e5f;
-  const test::SyntheticScene scene = scene64(o);
-  DenoiseInput input = scene.fullInput();
-  const float nan = std::numeric_limits<float>::quiet_NaN(),
-              inf = std::numeric_limits<float>::infinity();
-  SubBuffer& a = input.halves->at(0);
-  for (int x = 0; x < 64; ++x) {
-    // A feature without samples on two rows (as in Tungsten's buffers), a black zero-variance
-    // band, an infinite depth.
-    input.whole.visibility.varianceOfMean(x, 10, 0) = nan;
-    input.whole.albedo.varianceOfMean(x, 11, 2) = nan;
-    for (int y = 40; y < 44; ++y)
-      for (SubBuffer* b : {&input.whole, &a, &input.halves->at(1)})
-        for (int c = 0; c < 3; ++c) {
-          b->color.mean(x, y, c) = 0.0f;
-          b->color.varianceOfMean(x, y, c) = 0.0f;
-        }
-    a.depth.mean(x, 20, 0) = inf;
-  }
-  a.color.mean(5, 5, 0) = nan;
-  a.color.mean(6, 5, 1) = inf;
-  input.whole.color.varianceOfMean(7, 7, 1) = inf;
-  a.normal.mean(8, 8, 2) = -inf;
-  input.whole.color.mean(30, 30, 0) = 1e30f;
+  const test::SyntheticScene scene = test::syntheticScene(64, o);
   // (The black band is not expected to stay black here: NFOR's windows reach into it from the
   // firefly-laden neighbourhood, whose huge variance makes the band look similar.)
-  EXPECT_EQ(test::firstNonFinite(NforDenoiser().run(input)), "");
+  test::expectFiniteOnNonFiniteInputs(NforDenoiser(), scene, [](DenoiseInput& input) {
+    SubBuffer& a = input.halves->at(0);
+    for (int x = 0; x < 64; ++x) {
+      // A feature without samples on two rows (as in Tungsten's buffers), a black zero-variance
+      // band, an infinite depth.
+      input.whole.visibility.varianceOfMean(x, 10, 0) = test::kNan;
+      input.whole.albedo.varianceOfMean(x, 11, 2) = test::kNan;
+      for (int y = 40; y < 44; ++y)
+        for (SubBuffer* b : {&input.whole, &a, &input.halves->at(1)})
+          for (int c = 0; c < 3; ++c) {
+            b->color.mean(x, y, c) = 0.0f;
+            b->color.varianceOfMean(x, y, c) = 0.0f;
+          }
+      a.depth.mean(x, 20, 0) = test::kInf;
+    }
+    a.color.mean(5, 5, 0) = test::kNan;
+    a.color.mean(6, 5, 1) = test::kInf;
+    input.whole.color.varianceOfMean(7, 7, 1) = test::kInf;
+    a.normal.mean(8, 8, 2) = -test::kInf;
+    input.whole.color.mean(30, 30, 0) = 1e30f;
+  });
 }
 
 TEST(Nfor, RequirementsRegistryAndParameters) {
-  const auto nfor = createDenoiser("nfor:k1=0.4:k2=1.2:regressionR=7");
-  EXPECT_EQ(nfor->name(), "nfor");
-  EXPECT_TRUE(nfor->requirements().features);
-  EXPECT_TRUE(nfor->requirements().halves);
-  EXPECT_THROW(createDenoiser("nfor:bandwidth=1"), Error);
-  EXPECT_THROW(createDenoiser("nfor:k1=0"), Error);
-  EXPECT_THROW(createDenoiser("nfor:regressionR=-1"), Error);
-  const test::SyntheticScene scene = scene64();
-  DenoiseInput input = scene.fullInput();
-  input.halves.reset();
-  EXPECT_THROW(NforDenoiser().run(input), Error);
+  test::expectCreates("nfor:k1=0.4:k2=1.2:regressionR=7", "nfor",
+                      {.features = true, .halves = true});
+  test::expectRejected({"nfor:bandwidth=1", "nfor:k1=0", "nfor:regressionR=-1"});
+  test::expectNeedsHalves(NforDenoiser());
 }
 
 }  // namespace

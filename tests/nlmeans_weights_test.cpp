@@ -261,58 +261,62 @@ void checkAgainstBruteForce(const Ref& ref, const Image& data, double tol = 2e-5
   expectNear(got.weightSum, wantSum, tol, "weight sum");
 }
 
+// Random 16×16 inputs for one term: a smooth RGB guide (seeded with `seed`), its variance in
+// [varianceLo, varianceHi) (seed + 1) and the data to filter (seed + 2).
+struct OneTermInputs {
+  Image guide, variance, data;
+};
+
+OneTermInputs oneTermInputs(uint32_t seed, float varianceLo, float varianceHi,
+                            int dataChannels = 3) {
+  return {smoothRandom(16, 16, 3, seed, 0.0f, 1.0f),
+          test::randomImage(16, 16, 3, seed + 1, varianceLo, varianceHi),
+          test::randomImage(16, 16, dataChannels, seed + 2)};
+}
+
+// checkAgainstBruteForce for the single term `term` reading in.guide and in.variance.
+void checkTermAgainstBruteForce(const OneTermInputs& in, NlMeansTerm term,
+                                const NlMeansParams& params, int weightChannels = 1) {
+  term.guide = &in.guide;
+  term.variance = &in.variance;
+  Ref ref;
+  ref.terms = {term};
+  ref.params = params;
+  ref.weightChannels = weightChannels;
+  checkAgainstBruteForce(ref, in.data);
+}
+
 // ---- Agreement with the brute force --------------------------------------------------------
 
 TEST(NlMeansWeights, TungstenStylePerChannelMatchesBruteForce) {
-  const Image guide = smoothRandom(16, 16, 3, 1, 0.0f, 1.0f);
-  const Image variance = test::randomImage(16, 16, 3, 2, 0.001f, 0.02f);
-  const Image data = test::randomImage(16, 16, 3, 3);
-  Ref ref;
-  ref.terms = {NlMeansTerm{.guide = &guide,
-                           .variance = &variance,
-                           .f = 3,
-                           .k = 0.5f,
-                           .alpha = 1.0f,
-                           .s = 2.0f,
-                           .epsilon = 1e-7f,
-                           .distanceClamp = 1e4f,
-                           .channels = ChannelWeights::PerChannel}};
-  ref.params = {.r = 5, .center = CenterWeight::Computed, .minCenterWeight = 1e-4f};
-  ref.weightChannels = 3;
-  checkAgainstBruteForce(ref, data);
+  checkTermAgainstBruteForce(oneTermInputs(1, 0.001f, 0.02f),
+                             {.f = 3,
+                              .k = 0.5f,
+                              .alpha = 1.0f,
+                              .s = 2.0f,
+                              .epsilon = 1e-7f,
+                              .distanceClamp = 1e4f,
+                              .channels = ChannelWeights::PerChannel},
+                             {.r = 5, .center = CenterWeight::Computed, .minCenterWeight = 1e-4f},
+                             /*weightChannels=*/3);
 }
 
 TEST(NlMeansWeights, MinOverChannelsMatchesBruteForce) {
-  const Image guide = smoothRandom(16, 16, 3, 4, 0.0f, 1.0f);
-  const Image variance = test::randomImage(16, 16, 3, 5, 0.001f, 0.02f);
-  const Image data = test::randomImage(16, 16, 2, 6);
-  Ref ref;
-  ref.terms = {NlMeansTerm{.guide = &guide,
-                           .variance = &variance,
-                           .f = 2,
-                           .k = 1.0f,
-                           .s = 2.0f,
-                           .epsilon = 1e-7f,
-                           .channels = ChannelWeights::MinOverChannels}};
-  ref.params = {.r = 4, .minCenterWeight = 1e-4f};
-  checkAgainstBruteForce(ref, data);
+  checkTermAgainstBruteForce(
+      oneTermInputs(4, 0.001f, 0.02f, /*dataChannels=*/2),
+      {.f = 2, .k = 1.0f, .s = 2.0f, .epsilon = 1e-7f, .channels = ChannelWeights::MinOverChannels},
+      {.r = 4, .minCenterWeight = 1e-4f});
 }
 
 TEST(NlMeansWeights, RousselleStyleSymmetricPatchwiseMatchesBruteForce) {
-  const Image guide = smoothRandom(16, 16, 3, 7, 0.0f, 1.0f);
-  const Image variance = test::randomImage(16, 16, 3, 8, 0.002f, 0.03f);
-  const Image data = test::randomImage(16, 16, 3, 9);
-  Ref ref;
-  ref.terms = {NlMeansTerm{.guide = &guide,
-                           .variance = &variance,
-                           .f = 3,
-                           .k = 0.45f,
-                           .alpha = 1.0f,
-                           .channels = ChannelWeights::AverageDistance,
-                           .symmetricRefinement = true}};
-  ref.params = {
-      .r = 3, .weightBoxRadius = 3, .weightThreshold = 0.05f, .center = CenterWeight::One};
-  checkAgainstBruteForce(ref, data);
+  checkTermAgainstBruteForce(
+      oneTermInputs(7, 0.002f, 0.03f),
+      {.f = 3,
+       .k = 0.45f,
+       .alpha = 1.0f,
+       .channels = ChannelWeights::AverageDistance,
+       .symmetricRefinement = true},
+      {.r = 3, .weightBoxRadius = 3, .weightThreshold = 0.05f, .center = CenterWeight::One});
 }
 
 TEST(NlMeansWeights, FeatureTermsAndMaxCenterMatchBruteForce) {

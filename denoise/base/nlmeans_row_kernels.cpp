@@ -11,13 +11,10 @@
 
 #include "denoise/base/filters/fast_exp.h"
 
-// AVX-512F, AVX2 and baseline builds of every kernel (GCC function multiversioning through
-// ifunc); -mavx512f and -mavx2 do not enable FMA, so no contraction changes a result.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define ROW_KERNEL __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define ROW_KERNEL
-#endif
+#include "denoise/util/simd_clones.h"
+
+// AVX-512F, AVX2 and baseline builds of every kernel.
+#define ROW_KERNEL CHORUS_SIMD_CLONES
 
 namespace chorus::rows {
 namespace {

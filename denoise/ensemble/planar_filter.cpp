@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "denoise/util/fast_exp.h"
+#include "denoise/util/simd_clones.h"
 
 namespace chorus {
 namespace {
@@ -13,7 +14,7 @@ constexpr float kVarianceFloor = 1e-6f;
 // distances first (a loop that vectorises), then their exponentials.
 // Pointers start at p = (x0, y) and q = (x0 + dx, y + dy); plain int indexing so that the
 // loops vectorise.
-void kernelRow(const PlanarGuides& g, const BilateralKernel& kernel, int y, int dx, int dy, int x0,
+CHORUS_SIMD_CLONES void kernelRow(const PlanarGuides& g, const BilateralKernel& kernel, int y, int dx, int dy, int x0,
                int count, float* __restrict k) {
   const size_t pixels = size_t(g.width) * size_t(g.height);
   const size_t rowP = size_t(y) * size_t(g.width) + size_t(x0);
@@ -55,9 +56,10 @@ void kernelRow(const PlanarGuides& g, const BilateralKernel& kernel, int y, int 
 
 }  // namespace
 
-void filterPlaneRows(const PlanarGuides& guides, const BilateralKernel& kernel,
-                     std::span<const float* const> in, int inY0, int y0, int y1,
-                     std::span<float* const> out) {
+CHORUS_SIMD_CLONES void filterPlaneRows(const PlanarGuides& guides,
+                                        const BilateralKernel& kernel,
+                                        std::span<const float* const> in, int inY0, int y0,
+                                        int y1, std::span<float* const> out) {
   const int w = guides.width, h = guides.height, r = std::max(0, kernel.radius);
   const size_t planes = in.size();
   // The kernel is symmetric, k(s, s+δ) = k(s+δ, s) bit for bit, so it is evaluated once per

@@ -103,6 +103,18 @@ TEST(SweepRunner, ResumesOnlyMissingCasesAndReusesTheReference) {
   fewer.combiners = {"ensemble", "average"};
   EXPECT_EQ(runSweep(fewer).casesRun, 2);
   EXPECT_EQ(readCsv(dir / "results.csv").size(), 2 * (1 + 2 + 2u));
+
+  // Other scene settings (here the depth) would mix incomparable rows and reuse a stale
+  // reference: refused, naming the settings file, with nothing changed.
+  SweepConfig deeper = fewer;
+  deeper.render.maxDepth = fewer.render.maxDepth + 1;
+  try {
+    runSweep(deeper);
+    ADD_FAILURE() << "a sweep with other settings ran in the same directory";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("settings.txt"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(fs::last_write_time(reference), referenceTime);
 }
 
 TEST(SweepRunner, ShardsMergedEqualOneRun) {

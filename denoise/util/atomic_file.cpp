@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <fstream>
+#include <sstream>
 
 #include "denoise/util/error.h"
 
@@ -19,6 +20,14 @@ fs::path temporaryPathFor(const fs::path& target) {
   return tmp;
 }
 }  // namespace
+
+std::string readFileBytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw fileError(file, "cannot open");
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
 
 void ensureDirectory(const fs::path& dir) {
   if (dir.empty()) return;

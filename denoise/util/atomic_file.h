@@ -15,6 +15,9 @@ void writeAtomically(const std::filesystem::path& target,
 // Convenience for text outputs (JSON, CSV, HTML).
 void writeTextAtomically(const std::filesystem::path& target, const std::string& text);
 
+// The whole file's bytes; throws chorus::Error naming it when it cannot be read.
+std::string readFileBytes(const std::filesystem::path& file);
+
 // Creates `dir` (and parents); throws chorus::Error naming it when that fails.
 void ensureDirectory(const std::filesystem::path& dir);
 

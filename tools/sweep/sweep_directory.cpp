@@ -16,14 +16,6 @@ namespace {
 
 const char* kCropManifest = "crops.tsv";
 
-std::string readBinary(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw fileError(file, "cannot open");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 void writeBinary(const fs::path& file, const std::string& bytes) {
   writeTextAtomically(file, bytes);  // text and binary are the same bytes on POSIX
 }
@@ -31,7 +23,7 @@ void writeBinary(const fs::path& file, const std::string& bytes) {
 // Manifest lines: "scene\t<name>", "spp\t<N>", then "image|weight\t<label>\t<file>".
 SceneCrops readCaseCrops(const fs::path& caseDir) {
   const fs::path manifest = caseDir / kCropManifest;
-  std::istringstream in(readBinary(manifest));
+  std::istringstream in(readFileBytes(manifest));
   SceneCrops crops;
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
@@ -43,7 +35,7 @@ SceneCrops readCaseCrops(const fs::path& caseDir) {
     } else if (f.size() == 2 && f[0] == "spp") {
       crops.spp = std::atoi(f[1].c_str());
     } else if (f.size() == 3 && (f[0] == "image" || f[0] == "weight")) {
-      const std::string png = readBinary(caseDir / f[2]);
+      const std::string png = readFileBytes(caseDir / f[2]);
       (f[0] == "image" ? crops.images : crops.weightMaps)
           .push_back({f[1], std::vector<uint8_t>(png.begin(), png.end())});
     } else {
@@ -79,9 +71,9 @@ void copyTree(const fs::path& from, const fs::path& to) {
   });
   for (const fs::path& file : files) {
     const fs::path target = to / fs::relative(file, from);
-    const std::string bytes = readBinary(file);
+    const std::string bytes = readFileBytes(file);
     if (fs::exists(target)) {
-      if (readBinary(target) != bytes)
+      if (readFileBytes(target) != bytes)
         throw fileError(file, "conflicts with " + target.string() +
                                   " (the same case or reference with different content)");
       continue;
@@ -95,6 +87,10 @@ void copyTree(const fs::path& from, const fs::path& to) {
 
 fs::path caseCsvPath(const fs::path& dir, const SweepCase& c) {
   return dir / "cases" / (c.fileStem() + ".csv");
+}
+
+fs::path settingsPath(const fs::path& dir) {
+  return dir / "settings.txt";
 }
 
 fs::path referencePath(const fs::path& dir, const std::string& scene) {
@@ -145,9 +141,17 @@ std::vector<SweepRow> mergeSweeps(const fs::path& out, const std::vector<fs::pat
   for (const fs::path& input : inputs)
     if (!fs::is_directory(input / "cases"))
       throw fileError(input, "is not a sweep directory (no cases/ folder)");
+  // Slices of one sweep share its settings; rows of different settings are not comparable.
+  for (const fs::path& input : inputs)
+    if (fs::exists(settingsPath(input)) && fs::exists(settingsPath(inputs.front())) &&
+        readFileBytes(settingsPath(input)) != readFileBytes(settingsPath(inputs.front())))
+      throw fileError(settingsPath(input), "differs from " + settingsPath(inputs.front()).string() +
+                                               ": these sweeps ran with other settings");
   ensureDirectory(out);
   for (const fs::path& input : inputs) {
     if (fs::equivalent(input, out)) continue;
+    if (fs::exists(settingsPath(input)) && !fs::exists(settingsPath(out)))
+      writeTextAtomically(settingsPath(out), readFileBytes(settingsPath(input)));
     copyTree(input / "cases", out / "cases");
     copyTree(input / "references", out / "references");
   }

@@ -19,6 +19,8 @@ namespace chorus::sweep {
 
 std::filesystem::path caseCsvPath(const std::filesystem::path& dir, const SweepCase& c);
 std::filesystem::path referencePath(const std::filesystem::path& dir, const std::string& scene);
+// DIR/settings.txt: the settings every row of the directory was computed with.
+std::filesystem::path settingsPath(const std::filesystem::path& dir);
 
 // Writes the PNGs of `crops` and their manifest under DIR/cases/<stem>/ (manifest last).
 void writeCaseCrops(const std::filesystem::path& dir, const SweepCase& c, const SceneCrops& crops);

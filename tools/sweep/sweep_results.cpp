@@ -111,11 +111,7 @@ std::vector<SweepRow> parseCsv(const std::string& text, const std::filesystem::p
 }
 
 std::vector<SweepRow> readCsv(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw fileError(file, "cannot open");
-  std::stringstream text;
-  text << in.rdbuf();
-  return parseCsv(text.str(), file);
+  return parseCsv(readFileBytes(file), file);
 }
 
 void writeCsv(const std::filesystem::path& file, const std::vector<SweepRow>& rows) {

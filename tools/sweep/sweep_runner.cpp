@@ -6,6 +6,7 @@
 #include <memory>
 #include <ostream>
 #include <set>
+#include <sstream>
 
 #include "denoise/base/registry.h"
 #include "denoise/ensemble/ensemble.h"
@@ -79,6 +80,45 @@ Image readReference(const fs::path& file) {
 
 std::string sizeText(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
+}
+
+// Everything besides the method, combination and combiner lists that the rows of a sweep
+// directory depend on (DIR/settings.txt): a rerun with other settings would mix incomparable
+// rows, and its cached references would be stale.
+std::string sweepSettings(const SweepConfig& config) {
+  const render::RenderOptions& r = config.render;
+  const render::EnvironmentDesc& e = config.environment;
+  const CombineOptions& c = config.combine;
+  std::ostringstream text;
+  text << "size " << r.width << "x" << r.height << "\nseed " << r.seed << "\nmax-depth "
+       << r.maxDepth << "\nroulette " << r.rouletteStartDepth << "\ncamera " << r.camera
+       << "\nenvironment " << int(e.kind) << " " << e.radiance.r << "," << e.radiance.g << ","
+       << e.radiance.b << " " << e.source << " " << e.rotationDegrees << " " << e.intensity
+       << "\nreference";
+  for (const fs::path& file : config.references) text << " " << file.string();
+  if (config.references.empty())
+    text << " spp " << config.referenceSpp << " seconds " << config.referenceSeconds;
+  text << "\nensemble " << solverName(c.solver) << " "
+       << (c.mse.form == MseForm::Summed ? "summed" : "per-channel") << " window "
+       << c.mse.windowRadius << (c.mse.relative ? " relative" : " absolute") << " filter "
+       << (c.filter.enabled ? "bilateral" : "none") << " seed " << c.seed << "\ncrop "
+       << config.cropSize << "\n";
+  return text.str();
+}
+
+// Writes DIR/settings.txt, or throws chorus::Error naming it when DIR holds a sweep run with
+// other settings.
+void claimDirectory(const SweepConfig& config) {
+  const fs::path file = settingsPath(config.out);
+  const std::string settings = sweepSettings(config);
+  if (fs::exists(file)) {
+    if (readFileBytes(file) != settings)
+      throw fileError(file, "holds a sweep run with other settings (scene, reference or ensemble "
+                            "flags): rerun with those, or use another --out");
+    return;
+  }
+  ensureDirectory(config.out);
+  writeTextAtomically(file, settings);
 }
 
 // The reference of a scene: the given file, else DIR/references/<scene>.exr, rendered once
@@ -259,6 +299,7 @@ SweepRunStats runSweep(const SweepConfig& config) {
     if (!fs::is_regular_file(reference)) throw fileError(reference, "no such file");
   if (config.cropSize < 1) throw Error("crop size must be positive");
   const Plan plan = makePlan(config);
+  claimDirectory(config);
 
   const std::vector<SweepCase> all = planCases(config.scenes, config.spps);
   const std::vector<SweepCase> mine = casesOfShard(all, config.shard);

@@ -63,5 +63,17 @@ TEST(SweepPlan, IntLists) {
   EXPECT_THROW(parseIntList("x", "--spp"), Error);
 }
 
+TEST(SweepEta, LinearInSppOnceTwoSppAreKnown) {
+  // Case time 1 s + 0.5 s per spp: the fit recovers it exactly.
+  const std::vector<FinishedCase> finished = {{4, 3.0}, {16, 9.0}, {4, 3.0}};
+  EXPECT_NEAR(estimateRemainingSeconds(finished, {64, 256}), (1 + 32) + (1 + 128), 1e-9);
+  // One spp so far: the mean case time per remaining case.
+  EXPECT_NEAR(estimateRemainingSeconds({{4, 2.0}, {4, 4.0}}, {8, 16}), 6.0, 1e-12);
+  // Time falling with spp (noise) is not extrapolated below zero: slope 0, the mean.
+  EXPECT_NEAR(estimateRemainingSeconds({{4, 5.0}, {8, 3.0}}, {1024}), 4.0, 1e-12);
+  EXPECT_EQ(estimateRemainingSeconds({}, {4}), 0.0);
+  EXPECT_EQ(estimateRemainingSeconds({{4, 1.0}}, {}), 0.0);
+}
+
 }  // namespace
 }  // namespace chorus::sweep

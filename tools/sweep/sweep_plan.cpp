@@ -120,4 +120,23 @@ std::vector<int> parseIntList(const std::string& text, const std::string& flag) 
   return values;
 }
 
+double estimateRemainingSeconds(const std::vector<FinishedCase>& finished,
+                                const std::vector<int>& remainingSpps) {
+  if (finished.empty() || remainingSpps.empty()) return 0;
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (const FinishedCase& f : finished) {
+    const double x = f.spp, y = f.seconds;
+    n += 1, sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  const double variance = n * sxx - sx * sx;
+  double a = sy / n, b = 0;  // the mean, until two distinct spp are known
+  if (variance > 1e-9 * n * sxx) {
+    b = std::max(0.0, (n * sxy - sx * sy) / variance);
+    a = std::max(0.0, (sy - b * sx) / n);
+  }
+  double total = 0;
+  for (int spp : remainingSpps) total += a + b * spp;
+  return total;
+}
+
 }  // namespace chorus::sweep

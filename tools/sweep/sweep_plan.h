@@ -34,6 +34,16 @@ std::vector<SweepCase> casesOfShard(const std::vector<SweepCase>& cases, Shard s
 std::vector<std::string> planCombinations(const std::vector<std::string>& methods,
                                           const std::string& spec);
 
+// Seconds the cases still to run will take, from the finished ones: a case's time modelled as
+// a + b·spp (least squares, a and b ≥ 0; render time grows with spp, the denoisers' does not),
+// or the mean time while fewer than two distinct spp have finished.
+struct FinishedCase {
+  int spp = 0;
+  double seconds = 0;
+};
+double estimateRemainingSeconds(const std::vector<FinishedCase>& finished,
+                                const std::vector<int>& remainingSpps);
+
 // Parses "4,8,16" into positive integers; throws chorus::Error naming `flag` otherwise.
 std::vector<int> parseIntList(const std::string& text, const std::string& flag);
 

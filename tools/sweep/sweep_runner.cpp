@@ -323,7 +323,7 @@ SweepRunStats runSweep(const SweepConfig& config) {
       return render::buildScene(render::loadGltf(path), config.environment);
     };
   const Stopwatch sweepTime;
-  double caseSeconds = 0;
+  std::vector<FinishedCase> finished;
   for (size_t s = 0; s < config.scenes.size(); ++s) {
     std::vector<SweepCase> cases;
     for (const SweepCase& c : pending)
@@ -340,12 +340,12 @@ SweepRunStats runSweep(const SweepConfig& config) {
       writeCsv(caseCsvPath(config.out, c), result.rows);  // last: marks the case complete
       stats.ranCases.push_back(c.fileStem());
       ++stats.casesRun;
-      caseSeconds += caseTime.seconds();
+      finished.push_back({c.spp, caseTime.seconds()});
       if (config.progress) {
-        // ETA from the mean case time so far (cases at higher spp take longer: a lower bound
-        // early in a scene, refined as the sweep goes).
-        const double remaining =
-            caseSeconds / stats.casesRun * double(pending.size() - size_t(stats.casesRun));
+        std::vector<int> remainingSpps;
+        for (size_t k = size_t(stats.casesRun); k < pending.size(); ++k)
+          remainingSpps.push_back(pending[k].spp);
+        const double remaining = estimateRemainingSeconds(finished, remainingSpps);
         *config.progress << "sweep: [" << stats.casesRun << "/" << pending.size() << "] " << c.scene
                          << " at " << c.spp << " spp: " << result.rows.size() << " rows, elapsed "
                          << clockText(sweepTime.seconds()) << ", ETA " << clockText(remaining)

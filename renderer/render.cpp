@@ -5,11 +5,11 @@
 #include <tbb/task_arena.h>
 
 #include <atomic>
-#include <chrono>
 #include <mutex>
 #include <string>
 
 #include "denoise/util/error.h"
+#include "denoise/util/stopwatch.h"
 #include "renderer/integrator/camera.h"
 #include "renderer/integrator/film.h"
 #include "renderer/integrator/lights.h"
@@ -37,7 +37,7 @@ void validate(const RenderOptions& o) {
 RenderResult render(const Scene& scene, const RenderOptions& options,
                     const ProgressCallback& progress) {
   validate(options);
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch elapsed;
 
   // The camera's own aspect decides a missing dimension; the framing camera adapts to the image.
   const std::vector<CameraDesc>& cameras = scene.data().cameras;
@@ -85,8 +85,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
         uint64_t(x1 - x0) * uint64_t(y1 - y0) * uint64_t(options.spp);
     if (progress) {
       const std::lock_guard<std::mutex> lock(progressMutex);
-      progress({done, samplesTotal,
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()});
+      progress({done, samplesTotal, elapsed.seconds()});
     }
   };
 
@@ -107,7 +106,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
   s.height = resolution.height;
   s.spp = options.spp;
   s.splits = options.splits;
-  s.renderSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  s.renderSeconds = elapsed.seconds();
   s.samples = samplesTotal;
   s.rays = rays;
   s.nanSamplesDropped = dropped;

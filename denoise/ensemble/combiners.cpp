@@ -4,13 +4,13 @@
 #include <tbb/parallel_for.h>
 
 #include <bit>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
 #include "denoise/ensemble/blend.h"
 #include "denoise/ensemble/pairwise_solver.h"
 #include "denoise/util/error.h"
+#include "denoise/util/stopwatch.h"
 
 namespace chorus {
 namespace {
@@ -22,15 +22,11 @@ constexpr Combiner kAllCombiners[] = {Combiner::Ensemble,  Combiner::Average,
 class StageClock {
  public:
   explicit StageClock(std::vector<StageTime>& times) : times_(times) {}
-  void stop(const std::string& stage) {
-    const auto now = std::chrono::steady_clock::now();
-    times_.push_back({stage, std::chrono::duration<double>(now - start_).count()});
-    start_ = now;
-  }
+  void stop(const std::string& stage) { times_.push_back({stage, clock_.restart()}); }
 
  private:
   std::vector<StageTime>& times_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  Stopwatch clock_;
 };
 
 std::vector<Image> zeroMaps(int n, int width, int height, int channels) {

@@ -2,21 +2,13 @@
 
 #include <tbb/task_group.h>
 
-#include <chrono>
 #include <set>
 
 #include "denoise/ensemble/ensemble_types.h"
 #include "denoise/util/error.h"
+#include "denoise/util/stopwatch.h"
 
 namespace chorus {
-namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
-
 void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members) {
   if (members.empty()) throw Error("no base denoisers given");
   if (members.size() > size_t(kMaxDenoisers))
@@ -43,7 +35,7 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
                                           std::vector<StageTime>* times) {
   checkMembersCanRun(sources, members);
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch all;
   std::vector<BaseOutputs> outputs(members.size());
   std::vector<double> seconds(members.size() * 3);
   const DenoiseInput* inputs[3] = {&sources.a, &sources.b, &sources.full};
@@ -53,9 +45,9 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
     Image* targets[3] = {&outputs[m].a, &outputs[m].b, &outputs[m].full};
     for (int part = 0; part < 3; ++part) {
       group.run([&, m, part, target = targets[part]] {
-        const auto runStart = std::chrono::steady_clock::now();
+        const Stopwatch run;
         *target = members[m].denoiser->run(*inputs[part]);
-        seconds[m * 3 + size_t(part)] = secondsSince(runStart);
+        seconds[m * 3 + size_t(part)] = run.seconds();
       });
     }
   }
@@ -65,7 +57,7 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
     for (size_t m = 0; m < members.size(); ++m)
       for (int part = 0; part < 3; ++part)
         times->push_back({members[m].label + "/" + partNames[part], seconds[m * 3 + size_t(part)]});
-    times->push_back({"bases", secondsSince(start)});
+    times->push_back({"bases", all.seconds()});
   }
   return outputs;
 }

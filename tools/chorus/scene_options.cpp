@@ -1,8 +1,8 @@
 #include "tools/chorus/scene_options.h"
 
-#include <chrono>
 #include <iostream>
 
+#include "denoise/util/stopwatch.h"
 #include "renderer/scene/environment.h"
 #include "renderer/scene/gltf_loader.h"
 
@@ -52,17 +52,16 @@ std::string SceneOptions::environmentLabel(const Scene& scene) const {
 }
 
 LoadedScene loadScene(const std::string& path, const SceneOptions& options, bool quiet) {
-  using Clock = std::chrono::steady_clock;
   const EnvironmentDesc environment = options.environment();
-  auto start = Clock::now();
+  Stopwatch stage;
   SceneDesc desc = loadGltf(path);
-  const double loadSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const double loadSeconds = stage.restart();
   std::vector<std::string> warnings = desc.warnings;
-  for (const std::string& w : warnings) std::cerr << "chorus: warning: " << path << ": " << w << "\n";
+  for (const std::string& w : warnings)
+    std::cerr << "chorus: warning: " << path << ": " << w << "\n";
 
-  start = Clock::now();
   Scene scene = buildScene(std::move(desc), environment);
-  const double buildSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const double buildSeconds = stage.seconds();
   if (scene.usesDefaultEnvironment() && !quiet)
     std::cerr << "chorus: " << path
               << " has no lights: rendering under a uniform white environment (radiance 1)\n";

@@ -64,10 +64,9 @@ TEST(BaseDenoisersRendered, EveryDenoiserBeatsTheNoisyInput) {
 
 TEST(BaseDenoisersRendered, EnsembleOfAllBeatsEachMember) {
   const RenderedCase& c = cornellBox();
-  std::vector<EnsembleMember> members;
-  for (const DenoiserEntry& entry : builtinDenoisers())
-    members.push_back({entry.name, std::shared_ptr<const BaseDenoiser>(createDenoiser(entry.name))});
-  const EnsembleResult result = Ensemble(members, {}).run(c.buffers);
+  std::vector<std::string> names;
+  for (const DenoiserEntry& entry : builtinDenoisers()) names.push_back(entry.name);
+  const EnsembleResult result = Ensemble(membersFromSpecs(names), {}).run(c.buffers);
   ASSERT_EQ(test::firstNonFinite(result.combined.image), "");
   const double ensemble = relMse(result.combined.image, c.reference);
   std::cout << "ensemble of all: relMSE " << ensemble << "\n";

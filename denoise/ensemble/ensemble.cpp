@@ -4,11 +4,20 @@
 
 #include <set>
 
+#include "denoise/base/registry.h"
 #include "denoise/ensemble/ensemble_types.h"
 #include "denoise/util/error.h"
 #include "denoise/util/stopwatch.h"
 
 namespace chorus {
+
+std::vector<EnsembleMember> membersFromSpecs(std::span<const std::string> specs) {
+  std::vector<EnsembleMember> members;
+  for (const std::string& spec : specs)
+    members.push_back({spec, std::shared_ptr<const BaseDenoiser>(createDenoiser(spec))});
+  return members;
+}
+
 void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members) {
   if (members.empty()) throw Error("no base denoisers given");
   if (members.size() > size_t(kMaxDenoisers))

@@ -21,6 +21,10 @@ struct EnsembleMember {
   std::shared_ptr<const BaseDenoiser> denoiser;
 };
 
+// One member per registry spec ("nfor", "jnlm:k=0.4"), labelled with the spec. Throws
+// chorus::Error for an unknown name or parameter (denoise/base/registry.h).
+std::vector<EnsembleMember> membersFromSpecs(std::span<const std::string> specs);
+
 // Throws chorus::Error (one line) when a member cannot run on these sources, e.g. a denoiser
 // that needs two halves of its own input while the half buffers have none (K = 2 renders and
 // Tungsten directories: only the full buffer has halves).

@@ -200,4 +200,12 @@ Image readExrLayer(const fs::path& path, const std::string& name) {
       path, "no layer '" + (name.empty() ? "<default>" : name) + "' (layers: " + available + ")");
 }
 
+Image readRgbExr(const fs::path& path) {
+  Image image = readExrLayer(path);
+  if (image.channels() == 4) image = image.channelRange(0, 3);
+  if (image.channels() != 3)
+    throw fileError(path, "has " + std::to_string(image.channels()) + " channels, expected RGB");
+  return image;
+}
+
 }  // namespace chorus

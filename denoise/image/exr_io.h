@@ -38,6 +38,10 @@ std::vector<ExrLayer> readExr(const std::filesystem::path& path);
 // available layers when the requested one is missing.
 Image readExrLayer(const std::filesystem::path& path, const std::string& name = "");
 
+// The default layer as RGB (an alpha channel is dropped), e.g. a reference image. Throws
+// chorus::Error naming the file when it is not RGB or RGBA.
+Image readRgbExr(const std::filesystem::path& path);
+
 // Finds a layer in an already read file (nullptr when absent).
 const ExrLayer* findLayer(const std::vector<ExrLayer>& layers, const std::string& name);
 

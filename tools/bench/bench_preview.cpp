@@ -1,6 +1,7 @@
 // Preview latency (not a test; prints figures): what `chorus render --preview` does after the
 // scene is loaded — render at 4 spp with K = 4, run the preview members on half A, half B and
-// the full buffer, solve and blend (previews skip the weight filter), encode the PNG — timed end to end (best and median of
+// the full buffer, solve and blend (previews skip the weight filter), encode the PNG — timed end to
+// end (best and median of
 // --repeat runs, wall clock and process CPU time), on scenes/cornell-box.gltf at 512×512 by
 // default. The target is ≤ 1.0 s wall on 2 cores. Then the relMSE it reaches against a
 // high-spp reference (cached with --reference-cache), next to the noisy input and the full
@@ -33,13 +34,6 @@ double cpuSeconds() {
   getrusage(RUSAGE_SELF, &u);
   return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
          1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
-std::vector<EnsembleMember> members(const std::string& list) {
-  std::vector<EnsembleMember> out;
-  for (const std::string& spec : splitMethodList(list))
-    out.push_back({spec, std::shared_ptr<const BaseDenoiser>(createDenoiser(spec))});
-  return out;
 }
 
 struct Run {
@@ -93,8 +87,8 @@ int main(int argc, char** argv) {
 
   const Stopwatch load;
   const render::Scene scene = render::buildScene(render::loadGltf(scenePath), {});
-  std::printf("scene %s loaded and built in %.3f s (not in the figures below)\n",
-              scenePath.c_str(), load.seconds());
+  std::printf("scene %s loaded and built in %.3f s (not in the figures below)\n", scenePath.c_str(),
+              load.seconds());
   render::RenderOptions options;
   options.width = options.height = size;
   options.spp = spp;
@@ -102,7 +96,7 @@ int main(int argc, char** argv) {
   options.threads = threads;
   CombineOptions previewOptions;
   previewOptions.filter.enabled = false;  // as `chorus render --preview`
-  const Ensemble ensemble(members(preview), previewOptions);
+  const Ensemble ensemble(membersFromSpecs(splitMethodList(preview)), previewOptions);
 
   runOnce(scene, options, ensemble);  // warm-up: page faults, TBB start-up, dispatch tables
   std::vector<Run> runs;
@@ -110,11 +104,12 @@ int main(int argc, char** argv) {
   std::sort(runs.begin(), runs.end(), [](const Run& a, const Run& b) { return a.wall < b.wall; });
   const Run& best = runs.front();
   const Run& median = runs[runs.size() / 2];
-  std::printf("preview %s, %dx%d, %d spp, %d threads, %d runs:\n", preview.c_str(), size, size,
-              spp, threads, repeat);
+  std::printf("preview %s, %dx%d, %d spp, %d threads, %d runs:\n", preview.c_str(), size, size, spp,
+              threads, repeat);
   std::printf("  %-7s %7s %7s %7s %7s %7s %9s\n", "", "wall s", "cpu s", "render", "bases",
               "combine", "png");
-  for (const auto& [name, r] : {std::pair<const char*, const Run*>{"best", &best}, {"median", &median}})
+  for (const auto& [name, r] :
+       {std::pair<const char*, const Run*>{"best", &best}, {"median", &median}})
     std::printf("  %-7s %7.3f %7.3f %7.3f %7.3f %7.3f %9.3f\n", name, r->wall, r->cpu, r->render,
                 r->bases, r->combine, r->png);
   std::printf("  target: <= 1.0 s wall (best %s)\n", best.wall <= 1.0 ? "meets it" : "misses it");
@@ -127,7 +122,8 @@ int main(int argc, char** argv) {
                     : std::filesystem::path(cache) / ("preview-" + std::to_string(size) + "-" +
                                                       std::to_string(referenceSpp) + "spp.exr"),
       "bench_preview");
-  const Run fullRun = runOnce(scene, options, Ensemble(members(full), {}));
+  const Run fullRun =
+      runOnce(scene, options, Ensemble(membersFromSpecs(splitMethodList(full)), {}));
   std::printf("relMSE against a %d-spp reference at %d spp:\n", referenceSpp, spp);
   std::printf("  noisy                    %.5f\n", relMse(best.noisy, reference));
   std::printf("  preview (%s)  %.5f  (%.3f s)\n", preview.c_str(), relMse(best.image, reference),

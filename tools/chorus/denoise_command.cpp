@@ -51,7 +51,7 @@ struct LoadedInput {
 
 LoadedInput runBuiltins(const EnsembleSources& sources, const std::vector<std::string>& specs,
                         const std::string& kind, const fs::path& input) {
-  const std::vector<EnsembleMember> members = membersFromSpecs(specs);
+  const std::vector<EnsembleMember> members = fileSafeMembers(specs);
   LoadedInput loaded;
   loaded.kind = kind;
   try {
@@ -105,8 +105,10 @@ void runDenoise(const DenoiseArgs& args) {
 
   LoadedInput input = loadInput(args.input, specs);
   std::optional<Image> reference;
-  if (!args.reference.empty())
-    reference = readReference(args.reference, input.guides.width(), input.guides.height());
+  if (!args.reference.empty()) {
+    reference = readRgbExr(args.reference);
+    checkReferenceSize(*reference, args.reference, input.guides.width(), input.guides.height());
+  }
   for (Combiner c : combiners)
     if (needsReference(c) && !reference)
       throw Error("--combine " + std::string(combinerName(c)) + " needs --reference");
@@ -133,7 +135,7 @@ void runDenoise(const DenoiseArgs& args) {
     for (const StageTime& t : result.times) times[name + "/" + t.stage] = t.seconds;
     const Stopwatch write;
     writeCombined(out, name, result, input.bases,
-                k == 0 ? "weights.exr" : "weights-" + name + ".exr");
+                  k == 0 ? "weights.exr" : "weights-" + name + ".exr");
     times[name + "/write"] = write.seconds();
     if (reference) metrics[name] = metricsJson(result.image, *reference);
     std::cout << "wrote " << (out / (name + ".exr")).string() << "\n";

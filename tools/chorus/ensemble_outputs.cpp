@@ -3,7 +3,6 @@
 #include <cctype>
 #include <cmath>
 
-#include "denoise/base/registry.h"
 #include "denoise/image/exr_io.h"
 #include "denoise/image/png_io.h"
 #include "denoise/metrics/metrics.h"
@@ -20,22 +19,19 @@ std::string labelOf(const std::string& spec) {
   return label;
 }
 
-std::vector<EnsembleMember> membersFromSpecs(const std::vector<std::string>& specs) {
-  std::vector<EnsembleMember> members;
-  for (const std::string& spec : specs)
-    members.push_back({labelOf(spec), std::shared_ptr<const BaseDenoiser>(createDenoiser(spec))});
+std::vector<EnsembleMember> fileSafeMembers(const std::vector<std::string>& specs) {
+  std::vector<EnsembleMember> members = membersFromSpecs(specs);
+  for (EnsembleMember& member : members) member.label = labelOf(member.label);
   return members;
 }
 
-Image readReference(const std::filesystem::path& path, int width, int height) {
-  Image reference = readExrLayer(path);
-  if (reference.channels() == 4) reference = reference.channelRange(0, 3);
-  if (reference.channels() != 3 || reference.width() != width || reference.height() != height)
-    throw fileError(path, "is " + std::to_string(reference.width()) + "x" +
+void checkReferenceSize(const Image& reference, const std::filesystem::path& file, int width,
+                        int height) {
+  if (reference.width() != width || reference.height() != height)
+    throw fileError(file, "is " + std::to_string(reference.width()) + "x" +
                               std::to_string(reference.height()) + "x" +
                               std::to_string(reference.channels()) + ", expected " +
                               std::to_string(width) + "x" + std::to_string(height) + "x3");
-  return reference;
 }
 
 nlohmann::ordered_json metricsJson(const Image& image, const Image& reference) {

@@ -15,13 +15,12 @@ namespace chorus::cli {
 // A method spec as a file and layer name: "nlm:k=0.4" → "nlm_k=0.4".
 std::string labelOf(const std::string& spec);
 
-// One member per spec (registry names with optional parameters); throws chorus::Error for an
-// unknown name or parameter.
-std::vector<EnsembleMember> membersFromSpecs(const std::vector<std::string>& specs);
+// membersFromSpecs (denoise/ensemble/ensemble.h) with labelOf labels, for file and layer names.
+std::vector<EnsembleMember> fileSafeMembers(const std::vector<std::string>& specs);
 
-// Reads an RGB (or RGBA, alpha dropped) reference of the given size; throws chorus::Error
-// naming the file otherwise.
-Image readReference(const std::filesystem::path& path, int width, int height);
+// Throws chorus::Error naming `file` unless the reference read from it is width × height.
+void checkReferenceSize(const Image& reference, const std::filesystem::path& file, int width,
+                        int height);
 
 // {"relmse", "dssim", "psnr"} of image against reference (PSNR null when infinite).
 nlohmann::ordered_json metricsJson(const Image& image, const Image& reference);

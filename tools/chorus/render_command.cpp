@@ -4,8 +4,8 @@
 // --preview: 4 spp, the fast members, DIR/denoised.png and stats.json only.
 #include <nlohmann/json.hpp>
 
-#include <optional>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "denoise/buffers/buffers_exr.h"
@@ -16,9 +16,9 @@
 #include "denoise/util/stopwatch.h"
 #include "renderer/render.h"
 #include "tools/chorus/command.h"
-#include "tools/chorus/progress_bar.h"
 #include "tools/chorus/ensemble_flags.h"
 #include "tools/chorus/ensemble_outputs.h"
+#include "tools/chorus/progress_bar.h"
 #include "tools/chorus/render_denoise.h"
 #include "tools/chorus/scene_options.h"
 
@@ -64,8 +64,9 @@ nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderStats& s,
   j["camera"] = options.camera;
   j["threads"] = options.threads;
   j["environment"] = args.sceneOptions.environmentLabel(loaded.scene);
-  j["seconds"] = {
-      {"load", loaded.loadSeconds}, {"bvh_build", loaded.buildSeconds}, {"render", s.renderSeconds}};
+  j["seconds"] = {{"load", loaded.loadSeconds},
+                  {"bvh_build", loaded.buildSeconds},
+                  {"render", s.renderSeconds}};
   j["samples"] = s.samples;
   j["samples_per_second"] = s.samplesPerSecond();
   j["rays"] = s.rays;
@@ -86,7 +87,7 @@ void runRender(RenderArgs args) {
   std::optional<Image> reference;
   if (!args.reference.empty()) {
     if (!denoise.enabled()) throw Error("--reference needs --denoise");
-    reference = readExrLayer(args.reference);  // fails before the render; size checked after
+    reference = readRgbExr(args.reference);  // fails before the render; size checked after
   }
   const LoadedScene loaded = loadScene(args.scene, args.sceneOptions, args.quiet);
   const fs::path out = args.out;
@@ -128,11 +129,11 @@ void runRender(RenderArgs args) {
   result.buffers = {};
   double denoiseSeconds = 0;
   if (reference)  // checked after render.exr is safe on disk
-    *reference = readReference(args.reference, result.stats.width, result.stats.height);
+    checkReferenceSize(*reference, args.reference, result.stats.width, result.stats.height);
   if (sources) {
     denoiseSeconds = denoise.run(*sources, out, stats, reference ? &*reference : nullptr);
-    written += denoise.writeExrs ? "denoised.exr denoised.png weights.exr <member>.exr "
-                                 : "denoised.png ";
+    written +=
+        denoise.writeExrs ? "denoised.exr denoised.png weights.exr <member>.exr " : "denoised.png ";
   }
   written += "stats.json";
   stats["seconds"]["total"] = total.seconds();
@@ -154,7 +155,8 @@ const RegisterCommand registration(30, [](CLI::App& app) {
       "depth, visibility, with variances); writes DIR/render.exr, color.png, stats.json");
   cmd->add_option("scene", args->scene, "glTF scene (.gltf or .glb)")->required();
   cmd->add_option("--out", args->out, "Output directory")->capture_default_str();
-  cmd->add_option("--spp", args->sceneOptions.render.spp, "Samples per pixel (over all sub-buffers)")
+  cmd->add_option("--spp", args->sceneOptions.render.spp,
+                  "Samples per pixel (over all sub-buffers)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber)
       ->each([args](const std::string&) { args->sppGiven = true; });

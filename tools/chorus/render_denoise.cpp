@@ -1,7 +1,6 @@
 #include "tools/chorus/render_denoise.h"
 
 #include "denoise/base/registry.h"
-#include "denoise/ensemble/ensemble.h"
 #include "denoise/image/png_io.h"
 #include "denoise/util/error.h"
 #include "denoise/util/stopwatch.h"
@@ -9,8 +8,7 @@
 
 namespace chorus::cli {
 
-DenoiseStage DenoiseStage::parse(const std::string& list, CombineOptions options,
-                                 bool writeExrs) {
+DenoiseStage DenoiseStage::parse(const std::string& list, CombineOptions options, bool writeExrs) {
   DenoiseStage stage;
   stage.options = options;
   stage.writeExrs = writeExrs;
@@ -19,7 +17,8 @@ DenoiseStage DenoiseStage::parse(const std::string& list, CombineOptions options
                                : list == "preview" ? kPreviewDenoise
                                                    : list;
   stage.specs = splitMethodList(expanded);
-  membersFromSpecs(stage.specs);  // unknown names and parameters fail before the render
+  stage.members = fileSafeMembers(stage.specs);  // unknown names and parameters fail here,
+                                                 // before the render
   if (needsReference(options.combiner))
     throw Error("--combine " + std::string(combinerName(options.combiner)) +
                 " needs a reference: use `chorus denoise --reference` on render.exr");
@@ -27,8 +26,8 @@ DenoiseStage DenoiseStage::parse(const std::string& list, CombineOptions options
 }
 
 double DenoiseStage::run(const EnsembleSources& sources, const std::filesystem::path& dir,
-                       nlohmann::ordered_json& stats, const Image* reference) const {
-  const Ensemble ensemble(membersFromSpecs(specs), options);
+                         nlohmann::ordered_json& stats, const Image* reference) const {
+  const Ensemble ensemble(members, options);
   checkMembersCanRun(sources, ensemble.members());
   const Stopwatch denoise;
   const EnsembleResult result = ensemble.run(sources);

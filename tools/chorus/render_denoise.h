@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "denoise/ensemble/combiners.h"
-#include "denoise/ensemble/ensemble_inputs.h"
+#include "denoise/ensemble/ensemble.h"
 
 namespace chorus::cli {
 
@@ -22,7 +22,8 @@ inline constexpr const char* kDefaultDenoise = "nfor,rdfc,atrous";
 inline constexpr const char* kPreviewDenoise = "atrous,bilateral:sigmaS=2:sigmaC=0";
 
 struct DenoiseStage {
-  std::vector<std::string> specs;  // empty: render only (--denoise none)
+  std::vector<std::string> specs;       // empty: render only (--denoise none)
+  std::vector<EnsembleMember> members;  // built from specs once, by parse()
   CombineOptions options;
   bool writeExrs = true;  // false for previews: denoised.png only
 
@@ -40,7 +41,7 @@ struct DenoiseStage {
   // metrics of the noisy input, each member and the result to stats["metrics"].
   // Returns the seconds of the members and the combiner (without writing).
   double run(const EnsembleSources& sources, const std::filesystem::path& dir,
-           nlohmann::ordered_json& stats, const Image* reference) const;
+             nlohmann::ordered_json& stats, const Image* reference) const;
 };
 
 }  // namespace chorus::cli

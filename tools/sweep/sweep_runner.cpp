@@ -8,7 +8,6 @@
 #include <set>
 #include <sstream>
 
-#include "denoise/base/registry.h"
 #include "denoise/ensemble/ensemble.h"
 #include "denoise/image/exr_io.h"
 #include "denoise/image/false_color.h"
@@ -42,11 +41,10 @@ struct Plan {
 Plan makePlan(const SweepConfig& config) {
   Plan plan;
   if (config.methods.empty()) throw Error("--methods is empty");
-  for (const std::string& spec : config.methods) {
+  for (const std::string& spec : config.methods)
     if (std::count(config.methods.begin(), config.methods.end(), spec) > 1)
       throw Error("--methods lists '" + spec + "' twice");
-    plan.members.push_back({spec, std::shared_ptr<const BaseDenoiser>(createDenoiser(spec))});
-  }
+  plan.members = membersFromSpecs(config.methods);
   plan.combos = planCombinations(config.methods, config.combos);
   for (const std::string& name : config.combiners) plan.combiners.push_back(parseCombiner(name));
   plan.rowKeys.insert({"noisy", "-"});
@@ -68,14 +66,6 @@ bool caseIsComplete(const fs::path& csv, const Plan& plan) {
   std::set<std::pair<std::string, std::string>> keys;
   for (const SweepRow& r : readCsv(csv)) keys.insert({r.method, r.combiner});
   return keys == plan.rowKeys;
-}
-
-Image readReference(const fs::path& file) {
-  Image image = readExrLayer(file);
-  if (image.channels() == 4) image = image.channelRange(0, 3);
-  if (image.channels() != 3)
-    throw fileError(file, "has " + std::to_string(image.channels()) + " channels, expected RGB");
-  return image;
 }
 
 std::string sizeText(int width, int height) {
@@ -113,8 +103,9 @@ void claimDirectory(const SweepConfig& config) {
   const std::string settings = sweepSettings(config);
   if (fs::exists(file)) {
     if (readFileBytes(file) != settings)
-      throw fileError(file, "holds a sweep run with other settings (scene, reference or ensemble "
-                            "flags): rerun with those, or use another --out");
+      throw fileError(file,
+                      "holds a sweep run with other settings (scene, reference or ensemble "
+                      "flags): rerun with those, or use another --out");
     return;
   }
   ensureDirectory(config.out);
@@ -126,7 +117,7 @@ void claimDirectory(const SweepConfig& config) {
 fs::path obtainReference(const SweepConfig& config, size_t sceneIndex, const std::string& scene,
                          const render::Scene& built, Image* reference, SweepRunStats* stats) {
   if (!config.references.empty()) {
-    *reference = readReference(config.references[sceneIndex]);
+    *reference = readRgbExr(config.references[sceneIndex]);
     return config.references[sceneIndex];
   }
   const fs::path cached = referencePath(config.out, scene);

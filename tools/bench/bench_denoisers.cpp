@@ -118,7 +118,8 @@ std::vector<BenchCase> renderedCases(const BenchOptions& o) {
             ? fs::path()
             : fs::path(o.referenceCache) / (spec.name + "-" + std::to_string(o.renderWidth) + "-" +
                                             std::to_string(o.referenceSpp) + "spp.exr");
-    const Image reference = sweep::referenceRender(scene, options, cached, "bench_denoisers " + spec.name);
+    const Image reference =
+        sweep::referenceRender(scene, options, cached, "bench_denoisers " + spec.name);
     for (const std::string& spp : splitList(o.spp)) {
       options.spp = std::stoi(spp);
       options.splits = 4;

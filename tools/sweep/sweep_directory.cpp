@@ -1,7 +1,7 @@
 #include "tools/sweep/sweep_directory.h"
 
 #include <algorithm>
-#include <fstream>
+#include <optional>
 #include <sstream>
 #include <tuple>
 
@@ -15,10 +15,6 @@ namespace fs = std::filesystem;
 namespace {
 
 const char* kCropManifest = "crops.tsv";
-
-void writeBinary(const fs::path& file, const std::string& bytes) {
-  writeTextAtomically(file, bytes);  // text and binary are the same bytes on POSIX
-}
 
 // Manifest lines: "scene\t<name>", "spp\t<N>", then "image|weight\t<label>\t<file>".
 SceneCrops readCaseCrops(const fs::path& caseDir) {
@@ -79,7 +75,7 @@ void copyTree(const fs::path& from, const fs::path& to) {
       continue;
     }
     ensureDirectory(target.parent_path());
-    writeBinary(target, bytes);
+    writeTextAtomically(target, bytes);
   }
 }
 
@@ -105,7 +101,7 @@ void writeCaseCrops(const fs::path& dir, const SweepCase& c, const SceneCrops& c
   auto write = [&](const std::vector<ReportImage>& images, const std::string& kind) {
     for (size_t i = 0; i < images.size(); ++i) {
       const std::string file = kind + std::to_string(i) + ".png";
-      writeBinary(caseDir / file, std::string(images[i].png.begin(), images[i].png.end()));
+      writeTextAtomically(caseDir / file, std::string(images[i].png.begin(), images[i].png.end()));
       manifest << kind << "\t" << images[i].label << "\t" << file << "\n";
     }
   };
@@ -142,16 +138,21 @@ std::vector<SweepRow> mergeSweeps(const fs::path& out, const std::vector<fs::pat
     if (!fs::is_directory(input / "cases"))
       throw fileError(input, "is not a sweep directory (no cases/ folder)");
   // Slices of one sweep share its settings; rows of different settings are not comparable.
-  for (const fs::path& input : inputs)
-    if (fs::exists(settingsPath(input)) && fs::exists(settingsPath(inputs.front())) &&
-        readFileBytes(settingsPath(input)) != readFileBytes(settingsPath(inputs.front())))
-      throw fileError(settingsPath(input), "differs from " + settingsPath(inputs.front()).string() +
+  std::optional<std::pair<fs::path, std::string>> settings;  // the first input's that has some
+  for (const fs::path& input : inputs) {
+    if (!fs::exists(settingsPath(input))) continue;
+    const std::string text = readFileBytes(settingsPath(input));
+    if (!settings)
+      settings.emplace(settingsPath(input), text);
+    else if (text != settings->second)
+      throw fileError(settingsPath(input), "differs from " + settings->first.string() +
                                                ": these sweeps ran with other settings");
+  }
   ensureDirectory(out);
+  if (settings && !fs::exists(settingsPath(out)))
+    writeTextAtomically(settingsPath(out), settings->second);
   for (const fs::path& input : inputs) {
     if (fs::equivalent(input, out)) continue;
-    if (fs::exists(settingsPath(input)) && !fs::exists(settingsPath(out)))
-      writeTextAtomically(settingsPath(out), readFileBytes(settingsPath(input)));
     copyTree(input / "cases", out / "cases");
     copyTree(input / "references", out / "references");
   }

@@ -1,6 +1,5 @@
 #include "tools/sweep/sweep_results.h"
 
-#include <fstream>
 #include <iomanip>
 #include <limits>
 #include <sstream>

@@ -257,30 +257,53 @@ void atrousLevel(const Guide& g, const AtrousParams& params, AtrousKernelPath pa
 // enormous, and pixels that mix emitter and surface samples take huge demodulated values and
 // variances that leak into their neighbours (measured on the Cornell box: relMSE ×6 at 64
 // spp). Filtering those pixels as radiance avoids it; Tungsten instead records 1 + emission
-// as an emitter's albedo, which has the same effect.
+// as an emitter's albedo, which has the same effect. The guard square is dilated separably.
 std::vector<char> demodulationMask(const SubBuffer& buffer) {
   const int w = buffer.width(), h = buffer.height();
   const float* albedo = buffer.albedo.mean.data();
-  std::vector<char> black(size_t(w) * size_t(h)), mask(size_t(w) * size_t(h));
-  for (size_t i = 0; i < black.size(); ++i) {
-    float brightest = 0;
-    for (int c = 0; c < 3; ++c)
-      if (std::isfinite(albedo[i * 3 + size_t(c)]))
-        brightest = std::max(brightest, albedo[i * 3 + size_t(c)]);
-    black[i] = brightest < kEmitterAlbedo;
-  }
+  // nearBlack: some pixel within kEmitterGuard columns on the same row is black.
+  std::vector<char> nearBlack(size_t(w) * size_t(h)), mask(size_t(w) * size_t(h));
   tbb::parallel_for(0, h, [&](int y) {
+    std::vector<char> black(static_cast<size_t>(w));
     for (int x = 0; x < w; ++x) {
-      bool near = false;
-      for (int dy = -kEmitterGuard; dy <= kEmitterGuard && !near; ++dy)
-        for (int dx = -kEmitterGuard; dx <= kEmitterGuard && !near; ++dx) {
-          const int qx = x + dx, qy = y + dy;
-          near = qx >= 0 && qy >= 0 && qx < w && qy < h && black[size_t(qy * w + qx)];
-        }
-      mask[size_t(y * w + x)] = !near;
+      const float* a = albedo + (size_t(y) * size_t(w) + size_t(x)) * 3;
+      float brightest = 0;  // non-finite channels count as 0
+      for (int c = 0; c < 3; ++c)
+        brightest = std::isfinite(a[c]) && a[c] > brightest ? a[c] : brightest;
+      black[size_t(x)] = brightest < kEmitterAlbedo;
+    }
+    char* row = nearBlack.data() + size_t(y) * size_t(w);
+    for (int x = 0; x < w; ++x) {
+      char near = 0;
+      for (int qx = std::max(0, x - kEmitterGuard); qx <= std::min(w - 1, x + kEmitterGuard); ++qx)
+        near |= black[size_t(qx)];
+      row[x] = near;
+    }
+  });
+  tbb::parallel_for(0, h, [&](int y) {
+    char* row = mask.data() + size_t(y) * size_t(w);
+    std::fill(row, row + w, char(1));
+    for (int qy = std::max(0, y - kEmitterGuard); qy <= std::min(h - 1, y + kEmitterGuard); ++qy) {
+      const char* near = nearBlack.data() + size_t(qy) * size_t(w);
+      for (int x = 0; x < w; ++x) row[x] &= char(!near[x]);
     }
   });
   return mask;
+}
+
+// Row y's demodulation divisors, interleaved RGB: max(albedo, 1e-3) (non-finite albedo counts
+// as 0) where the mask demodulates, else 1.
+void demodulationDivisors(const SubBuffer& buffer, const std::vector<char>& demodulated, int y,
+                          std::vector<float>& divisors) {
+  const int w = buffer.width();
+  const size_t first = size_t(y) * size_t(w);
+  const float* albedo = buffer.albedo.mean.data() + first * 3;
+  for (int x = 0; x < w; ++x)
+    for (int c = 0; c < 3; ++c) {
+      const size_t e = size_t(3 * x + c);
+      const float a = std::isfinite(albedo[e]) ? std::max(albedo[e], kAlbedoFloor) : kAlbedoFloor;
+      divisors[e] = demodulated[first + size_t(x)] ? a : 1.0f;
+    }
 }
 
 }  // namespace
@@ -289,31 +312,31 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKerne
   const int w = buffer.width(), h = buffer.height();
   const float* color = buffer.color.mean.data();
   const float* colorVariance = buffer.color.varianceOfMean.data();
-  const float* albedo = buffer.albedo.mean.data();
-  // Demodulation mask: pixels within `kEmitterGuard` pixels of one whose albedo is below
+  // Demodulation: pixels within `kEmitterGuard` pixels of one whose albedo is below
   // kEmitterAlbedo are filtered as radiance (see demodulationMask).
   const std::vector<char> demodulated =
       params.demodulate ? demodulationMask(buffer) : std::vector<char>(size_t(w) * size_t(h), 0);
-  // The demodulation divisor max(albedo, 1e-3) (non-finite albedo counts as 0), or 1.
-  const auto divisor = [&](size_t e) {
-    return demodulated[e / 3] ? std::max(std::isfinite(albedo[e]) ? albedo[e] : 0.0f, kAlbedoFloor)
-                              : 1.0f;
-  };
   // Taps reach 2·2^(iterations−1) pixels past the borders: zero margins that wide.
   const int margin = 1 << params.iterations;
   // Demodulate; luminance variance (Σ a_c √V_c)², V_c of the demodulated colour.
   PaddedPlanes state(w, h, kStatePlanes, margin);
   tbb::parallel_for(0, h, [&](int y) {
+    std::vector<float> divisors(size_t(3 * w));
+    demodulationDivisors(buffer, demodulated, y, divisors);
+    const size_t first = size_t(y) * size_t(w) * 3, o = state.index(0, y);
+    float* rgb[3] = {state.plane(kRed) + o, state.plane(kGreen) + o, state.plane(kBlue) + o};
+    float* variance = state.plane(kVariance) + o;
     for (int x = 0; x < w; ++x) {
-      const size_t i = size_t(y) * size_t(w) + size_t(x), o = state.index(x, y);
       float deviation = 0;
       for (int c = 0; c < 3; ++c) {
-        const size_t e = i * 3 + size_t(c);
-        const float a = divisor(e), v = colorVariance[e];
-        state.plane(kRed + c)[o] = (std::isfinite(color[e]) ? color[e] : 0.0f) / a;
-        deviation += kLuminance[size_t(c)] * std::sqrt(std::isfinite(v) && v > 0 ? v : 0.0f) / a;
+        const size_t e = size_t(3 * x + c);
+        const float inverse = 1.0f / divisors[e], m = color[first + e],
+                    v = colorVariance[first + e];
+        rgb[c][x] = (std::isfinite(m) ? m : 0.0f) * inverse;
+        deviation +=
+            kLuminance[size_t(c)] * std::sqrt(std::isfinite(v) && v > 0 ? v : 0.0f) * inverse;
       }
-      state.plane(kVariance)[o] = deviation * deviation;
+      variance[x] = deviation * deviation;
     }
   });
   if (params.clampFireflies) clampFireflies(state);
@@ -330,13 +353,15 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKerne
   // Remodulate.
   Image out(w, h, 3);
   tbb::parallel_for(0, h, [&](int y) {
-    for (int x = 0; x < w; ++x) {
-      const size_t i = size_t(y) * size_t(w) + size_t(x);
+    std::vector<float> divisors(size_t(3 * w));
+    demodulationDivisors(buffer, demodulated, y, divisors);
+    float* row = out.data() + size_t(y) * size_t(w) * 3;
+    const size_t o = state.index(0, y);
+    for (int x = 0; x < w; ++x)
       for (int c = 0; c < 3; ++c) {
-        const float v = state.plane(kRed + c)[state.index(x, y)] * divisor(i * 3 + size_t(c));
-        out.data()[i * 3 + size_t(c)] = std::isfinite(v) ? v : 0.0f;
+        const float v = state.plane(kRed + c)[o + size_t(x)] * divisors[size_t(3 * x + c)];
+        row[3 * x + c] = std::isfinite(v) ? v : 0.0f;
       }
-    }
   });
   return out;
 }

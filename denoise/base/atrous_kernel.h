@@ -101,6 +101,12 @@ void filterPixels(const AtrousLevelInputs& in, int x, int y, float* const outCol
   const F stepGy = gy * F::broadcast(float(in.step));
   const F xTerm[5] = {zero - (stepGx + stepGx), zero - stepGx, zero, stepGx, stepGx + stepGx};
   const F yTerm[5] = {zero - (stepGy + stepGy), zero - stepGy, zero, stepGy, stepGy + stepGy};
+  // 1 / (|∇z·δ| + ε_z) for the taps before the centre (k = 5(ty + 2) + tx + 2 < 12); the tap
+  // mirrored through the centre (24 − k) has exactly the same |∇z·δ| (the tables are negations
+  // of each other), so twelve divisions serve all 24 off-centre taps.
+  F inverseDepthScale[12];
+  for (int k = 0; k < 12; ++k)
+    inverseDepthScale[k] = one / (abs(xTerm[k % 5] + yTerm[k / 5]) + epsilon);
   F sum[3] = {F::broadcast(0), F::broadcast(0), F::broadcast(0)};
   F weightSum = F::broadcast(0), varianceSum = F::broadcast(0);
   for (int ty = -2; ty <= 2; ++ty) {
@@ -111,17 +117,21 @@ void filterPixels(const AtrousLevelInputs& in, int x, int y, float* const outCol
       const ptrdiff_t q = ptrdiff_t(qy) * in.stride + qx;
       const F kernel = F::broadcast(kB3Spline[size_t(tx + 2)] * kB3Spline[size_t(ty + 2)]);
       // w_z w_l = exp(−|Δz| / (σ_z |∇z·δ| + ε_z) − |Δl| / (σ_l √Var + ε_l)); σ_z is in ∇z.
-      const F depthScale = abs(xTerm[tx + 2] + yTerm[ty + 2]) + epsilon;
-      const F e = abs(zp - F::load(in.z + q)) / depthScale +
-                  abs(lp - F::load(in.luminance + q)) * tolerance;
-      F w = kernel * expNegated(e);
+      // At the centre both differences are 0 and exp(−0) is exactly 1.
+      const int k = 5 * (ty + 2) + tx + 2;
+      F w = kernel;
+      if (k != 12) {
+        const F e = abs(zp - F::load(in.z + q)) * inverseDepthScale[k < 12 ? k : 24 - k] +
+                    abs(lp - F::load(in.luminance + q)) * tolerance;
+        w = w * expNegated(e);
+      }
       if constexpr (kSquarings >= 0) {
         // w_n = max(0, n_p·n_q)^(2^kSquarings).
         const F dot = F::load(in.nx + p) * F::load(in.nx + q) +
                       F::load(in.ny + p) * F::load(in.ny + q) +
                       F::load(in.nz + p) * F::load(in.nz + q);
         F wn = max0(dot);
-        for (int k = 0; k < kSquarings; ++k) wn = wn * wn;
+        for (int s = 0; s < kSquarings; ++s) wn = wn * wn;
         if constexpr (kUnknownNormals) {
           // A pixel without a normal does not constrain: w_n = 1 unless both are known.
           const F both = F::load(in.hasNormal + p) * F::load(in.hasNormal + q);

@@ -55,6 +55,7 @@ Float8 max0(Float8 a) {
 }
 
 // exp(−e), lane for lane the operations of fastExpNonPositive (fast_exp.h).
+template <int kDegree>
 Float8 expNegated(Float8 e) {
   using namespace fast_exp_detail;
   __m256 t = _mm256_mul_ps(e.v, _mm256_set1_ps(-kLog2e));
@@ -66,8 +67,9 @@ Float8 expNegated(Float8 e) {
   const __m256i biased = _mm256_add_epi32(_mm256_castps_si256(rounded),
                                           _mm256_set1_epi32(127 - std::bit_cast<int32_t>(kRound)));
   const __m256 y = _mm256_mul_ps(_mm256_sub_ps(t, n), _mm256_set1_ps(kLn2));
-  __m256 p = _mm256_set1_ps(kTaylor[0]);
-  for (int k = 1; k < 7; ++k) p = _mm256_add_ps(_mm256_mul_ps(p, y), _mm256_set1_ps(kTaylor[k]));
+  __m256 p = _mm256_set1_ps(kExpPolynomial<kDegree>[0]);
+  for (int k = 1; k <= kDegree; ++k)
+    p = _mm256_add_ps(_mm256_mul_ps(p, y), _mm256_set1_ps(kExpPolynomial<kDegree>[size_t(k)]));
   return {_mm256_mul_ps(p, _mm256_castsi256_ps(_mm256_slli_epi32(biased, 23)))};
 }
 

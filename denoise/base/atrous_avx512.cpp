@@ -59,6 +59,7 @@ Float16 abs(Float16 a) {
 Float16 max0(Float16 a) {
   return {_mm512_max_ps(a.v, _mm512_setzero_ps())};
 }
+template <int kDegree>
 Float16 expNegated(Float16 e) {
   using namespace fast_exp_detail;
   __m512 t = _mm512_mul_ps(e.v, _mm512_set1_ps(-kLog2e));
@@ -70,8 +71,9 @@ Float16 expNegated(Float16 e) {
   const __m512i biased = _mm512_add_epi32(_mm512_castps_si512(rounded),
                                           _mm512_set1_epi32(127 - std::bit_cast<int32_t>(kRound)));
   const __m512 y = _mm512_mul_ps(_mm512_sub_ps(t, n), _mm512_set1_ps(kLn2));
-  __m512 p = _mm512_set1_ps(kTaylor[0]);
-  for (int k = 1; k < 7; ++k) p = _mm512_add_ps(_mm512_mul_ps(p, y), _mm512_set1_ps(kTaylor[k]));
+  __m512 p = _mm512_set1_ps(kExpPolynomial<kDegree>[0]);
+  for (int k = 1; k <= kDegree; ++k)
+    p = _mm512_add_ps(_mm512_mul_ps(p, y), _mm512_set1_ps(kExpPolynomial<kDegree>[size_t(k)]));
   return {_mm512_mul_ps(p, _mm512_castsi512_ps(_mm512_slli_epi32(biased, 23)))};
 }
 

@@ -74,13 +74,16 @@ template <class F>
 Pair<F> max0(Pair<F> x) {
   return {max0(x.a), max0(x.b)};
 }
-template <class F>
+template <int kDegree, class F>
 Pair<F> expNegated(Pair<F> x) {
-  return {expNegated(x.a), expNegated(x.b)};
+  return {expNegated<kDegree>(x.a), expNegated<kDegree>(x.b)};
 }
 
 constexpr std::array<float, 5> kB3Spline = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};
 constexpr float kDepthEpsilon = 1e-3f;  // on depth / max depth
+// The weights' exponential: degree 4 (relative error 3.5e-6) costs two multiply-adds less per
+// tap than the full-precision 6 (measured: 7% of à-trous's time).
+constexpr int kExpDegree = 4;
 
 // Filters F::kWidth consecutive pixels from (x, y) with the weights of the header. kBorder:
 // some tap may lie left or right of the image: its weight is multiplied by inside[qx] = 0 (the
@@ -123,7 +126,7 @@ void filterPixels(const AtrousLevelInputs& in, int x, int y, float* const outCol
       if (k != 12) {
         const F e = abs(zp - F::load(in.z + q)) * inverseDepthScale[k < 12 ? k : 24 - k] +
                     abs(lp - F::load(in.luminance + q)) * tolerance;
-        w = w * expNegated(e);
+        w = w * expNegated<kExpDegree>(e);
       }
       if constexpr (kSquarings >= 0) {
         // w_n = max(0, n_p·n_q)^(2^kSquarings).

@@ -68,9 +68,11 @@ inline Float1 max0(Float1 a) {
 inline Float1 sqrt(Float1 a) {
   return {std::sqrt(a.v)};
 }
+// exp(−e), with fast_exp.h's polynomial of degree kDegree.
+template <int kDegree = 6>
 inline Float1 expNegated(Float1 e) {
-  return {fastExpNonPositive(-e.v)};
-}  // exp(−e)
+  return {fastExpNonPositive<kDegree>(-e.v)};
+}
 
 #if defined(__SSE2__)
 struct Float4 {
@@ -102,8 +104,9 @@ inline Float4 max0(Float4 a) {
 inline Float4 sqrt(Float4 a) {
   return {_mm_sqrt_ps(a.v)};
 }
+template <int kDegree = 6>
 inline Float4 expNegated(Float4 e) {
-  return {fastExpNegatedSse(e.v)};
+  return {fastExpNegatedSse<kDegree>(e.v)};
 }
 
 #endif

@@ -162,52 +162,60 @@ using StatisticsLanes = Float4;
 using StatisticsLanes = Float1;
 #endif
 
-// Luminance of row y and its inverse tolerance 1 / (σ_l √(g3×3 ∗ Var) + ε_l), with the 3×3
-// Gaussian (1/4 centre, 1/8 edges, 1/16 corners) clipped and renormalised at the borders,
-// applied separably ([1 2 1] / 4 per axis, / 3 where one side is missing, / 2 with none).
-// `rowScratch` holds 3 rows of w floats.
-void levelStatistics(const PaddedPlanes& state, float sigmaL, int y, PaddedPlanes& statistics,
-                     std::vector<float>& rowScratch) {
+// Luminance of rows [first, last) and their inverse tolerance 1 / (σ_l √(g3×3 ∗ Var) + ε_l),
+// with the 3×3 Gaussian (1/4 centre, 1/8 edges, 1/16 corners) clipped and renormalised at the
+// borders, applied separably ([1 2 1] / 4 per axis, / 3 where one side is missing, / 2 with
+// none). Each row is smoothed horizontally once, into a ring of three rows.
+void levelStatistics(const PaddedPlanes& state, float sigmaL, int first, int last,
+                     PaddedPlanes& statistics) {
   const int w = state.width(), h = state.height();
   const float* variance = state.plane(kVariance);
-  float* smoothed[3] = {rowScratch.data(), rowScratch.data() + w, rowScratch.data() + 2 * w};
+  std::vector<float> scratch(size_t(3 * w));
+  // Horizontally smoothed variance of rows y − 1, y, y + 1 (zeros outside the image).
+  float* ring[3] = {scratch.data(), scratch.data() + w, scratch.data() + 2 * w};
   const auto axisNorm = [](int pos, int size) {
     return 1.0f / (2.0f + (pos > 0 ? 1.0f : 0.0f) + (pos + 1 < size ? 1.0f : 0.0f));
   };
-  for (int dy = -1; dy <= 1; ++dy) {
-    const int qy = y + dy;
-    float* out = smoothed[dy + 1];
+  const auto smoothRow = [&](int qy, float* out) {
     if (qy < 0 || qy >= h) {
       std::fill(out, out + w, 0.0f);
-      continue;
+      return;
     }
     const float* v = variance + state.index(0, qy);  // columns −1 and w read the zero margin
     for (int x = 0; x < w; ++x) out[x] = v[x - 1] + 2.0f * v[x] + v[x + 1];
     out[0] *= axisNorm(0, w);
     for (int x = 1; x < w - 1; ++x) out[x] *= 0.25f;
     if (w > 1) out[w - 1] *= axisNorm(w - 1, w);
-  }
-  const float yNorm = axisNorm(y, h);
-  float* luminance = statistics.plane(0) + state.index(0, y);
-  float* tolerance = statistics.plane(1) + state.index(0, y);
-  const float* color[3] = {state.plane(kRed) + state.index(0, y),
-                           state.plane(kGreen) + state.index(0, y),
-                           state.plane(kBlue) + state.index(0, y)};
-  for (int x = 0; x < w; ++x) {
-    luminance[x] =
-        kLuminance[0] * color[0][x] + kLuminance[1] * color[1][x] + kLuminance[2] * color[2][x];
-    smoothed[1][x] = (smoothed[0][x] + 2.0f * smoothed[1][x] + smoothed[2][x]) * yNorm;
-  }
-  const auto toleranceOf = [&](auto lanes, int x) {
-    using F = decltype(lanes);
-    const F g = F::load(smoothed[1] + x);
-    (F::broadcast(1.0f) / (F::broadcast(sigmaL) * sqrt(g) + F::broadcast(kLuminanceEpsilon)))
-        .store(tolerance + x);
   };
-  int x = 0;
-  for (; x + StatisticsLanes::kWidth <= w; x += StatisticsLanes::kWidth)
-    toleranceOf(StatisticsLanes{}, x);
-  for (; x < w; ++x) toleranceOf(Float1{}, x);
+  smoothRow(first - 1, ring[0]);
+  smoothRow(first, ring[1]);
+  for (int y = first; y < last; ++y) {
+    smoothRow(y + 1, ring[2]);
+    const float yNorm = axisNorm(y, h);
+    float* luminance = statistics.plane(0) + state.index(0, y);
+    float* tolerance = statistics.plane(1) + state.index(0, y);
+    const float* color[3] = {state.plane(kRed) + state.index(0, y),
+                             state.plane(kGreen) + state.index(0, y),
+                             state.plane(kBlue) + state.index(0, y)};
+    // In lanes: the compiler does not vectorise this loop by itself (the rows might alias).
+    const auto toleranceOf = [&](auto lanes, int x) {
+      using F = decltype(lanes);
+      (F::broadcast(kLuminance[0]) * F::load(color[0] + x) +
+       F::broadcast(kLuminance[1]) * F::load(color[1] + x) +
+       F::broadcast(kLuminance[2]) * F::load(color[2] + x))
+          .store(luminance + x);
+      const F g = (F::load(ring[0] + x) + F::broadcast(2.0f) * F::load(ring[1] + x) +
+                   F::load(ring[2] + x)) *
+                  F::broadcast(yNorm);
+      (F::broadcast(1.0f) / (F::broadcast(sigmaL) * sqrt(g) + F::broadcast(kLuminanceEpsilon)))
+          .store(tolerance + x);
+    };
+    int x = 0;
+    for (; x + StatisticsLanes::kWidth <= w; x += StatisticsLanes::kWidth)
+      toleranceOf(StatisticsLanes{}, x);
+    for (; x < w; ++x) toleranceOf(Float1{}, x);
+    std::rotate(ring, ring + 1, ring + 3);  // row y + 1 becomes the centre
+  }
 }
 
 // One à-trous level with tap spacing `step`: state → next (colour and luminance variance).
@@ -217,9 +225,7 @@ void atrousLevel(const Guide& g, const AtrousParams& params, AtrousKernelPath pa
                  const std::vector<float>& inside) {
   const int w = state.width(), h = state.height();
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
-    std::vector<float> scratch(size_t(3 * w));
-    for (int y = rows.begin(); y < rows.end(); ++y)
-      levelStatistics(state, params.sigmaL, y, statistics, scratch);
+    levelStatistics(state, params.sigmaL, rows.begin(), rows.end(), statistics);
   });
 
   // Pointers to pixel (0, 0) of each plane (all planes share the padded layout).

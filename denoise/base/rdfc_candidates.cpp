@@ -17,7 +17,10 @@
 namespace chorus {
 namespace {
 
-constexpr int kTileWidth = 64, kTileHeight = 32;
+// Wide, short tiles: each row-kernel call covers 128 pixels, so the per-call overhead of the
+// ~100 calls per tile row and offset is spread over twice as many pixels as with 64 × 32
+// (candidates 30.4 → 23.9 CPU s/Mpx on the synthetic 1024² case; same pixel count per tile).
+constexpr int kTileWidth = 128, kTileHeight = 16;
 constexpr float kMinCenterWeight = 1e-3f;  // the release's WEIGHT_EPSILON
 constexpr float kSymmetricLimit = 25.0f;   // refine only where both distances are below this
 constexpr int kColor = 2;                  // FIRST and SECOND have a colour term

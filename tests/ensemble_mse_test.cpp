@@ -102,12 +102,38 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
   PixelMse out;
   out.groups = groups;
   for (int g = 0; g < groups; ++g) out.h[size_t(g)] = MseMatrix::Zero(n, n);
+  // outlierCap F scales each pixel's terms by F / (tr H (all groups) / u + F), u the unit the
+  // estimator stores values in: 1 for the relative form, else the mean |x^A|, |x^B| squared.
+  double unit = 1.0;
+  if (!o.relative) {
+    double sum = 0;
+    for (const Image* image : {&f.guides.colorA, &f.guides.colorB})
+      for (float v : image->values()) sum += std::abs(v);
+    unit = std::pow(sum / double(2 * f.truth.size()), 2);
+  }
   double kernelSum = 0;
   for (int qy = std::max(0, y - o.windowRadius); qy <= std::min(h - 1, y + o.windowRadius); ++qy)
     for (int qx = std::max(0, x - o.windowRadius); qx <= std::min(w - 1, x + o.windowRadius);
          ++qx) {
-      const double k = windowWeight(f, o, x, y, qx, qy);
+      double k = windowWeight(f, o, x, y, qx, qy);
       kernelSum += k;
+      if (o.outlierCap > 0) {
+        double trace = 0;  // Σ_c Σ_i ½((y_i^A − x^B)² + (y_i^B − x^A)²), weighted as below
+        for (int c = 0; c < 3; ++c) {
+          const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
+          double weight = 1.0;
+          if (o.relative) {
+            double mu = 0;
+            for (const BaseOutputs& b : f.bases) mu += b.full(qx, qy, c);
+            mu /= n;
+            weight /= mu * mu + kRelMseEpsilon;
+          }
+          for (const BaseOutputs& b : f.bases)
+            trace += weight * 0.5 *
+                     (std::pow(b.a(qx, qy, c) - xB, 2) + std::pow(b.b(qx, qy, c) - xA, 2));
+        }
+        k *= o.outlierCap / (trace / unit + o.outlierCap);
+      }
       for (int c = 0; c < 3; ++c) {
         const int g = groups == 3 ? c : 0;
         const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
@@ -144,32 +170,37 @@ TEST(MseEstimate, MatchesTheDefinition) {
   const Fixture f = makeFixture(19, 14, 1);
   for (MseForm form : {MseForm::PerChannel, MseForm::Summed})
     for (int radius : {0, 2})
-      for (bool relative : {false, true}) {
-        MseOptions o;
-        o.form = form;
-        o.windowRadius = radius;
-        o.relative = relative;
-        const MseEstimator estimator(f.guides, pointers(f), o);
-        for (int y = 0; y < 14; y += 3)
-          for (int x = 0; x < 19; x += 2) {
-            const PixelMse got = estimator.at(x, y), expected = naiveMse(f, o, x, y);
-            ASSERT_EQ(got.groups, expected.groups);
-            EXPECT_EQ(got.valid, 0b111u);
-            for (int g = 0; g < got.groups; ++g) {
-              const MseMatrix m = full(got, g);
-              const double tolerance = 1e-5 * expected.h[size_t(g)].cwiseAbs().maxCoeff() + 1e-9;
-              for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j)
-                  ASSERT_NEAR(m(i, j), expected.h[size_t(g)](i, j), tolerance)
-                      << "form " << int(form) << " radius " << radius << " relative " << relative
-                      << " pixel " << x << "," << y << " entry " << i << j;
-              // The solver's part h is positive semi-definite.
-              const Eigen::MatrixXd h = got.h[size_t(g)];
-              EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(h).eigenvalues().minCoeff(),
-                        -1e-6 * h.trace());
+      for (bool relative : {false, true})
+        for (double outlierCap : {0.0, 0.5}) {
+          MseOptions o;
+          o.form = form;
+          o.windowRadius = radius;
+          o.relative = relative;
+          o.outlierCap = outlierCap;
+          o.consistency = 0;  // a solver mask: it does not change the estimate
+          const MseEstimator estimator(f.guides, pointers(f), o);
+          for (int y = 0; y < 14; y += 3)
+            for (int x = 0; x < 19; x += 2) {
+              const PixelMse got = estimator.at(x, y), expected = naiveMse(f, o, x, y);
+              ASSERT_EQ(got.groups, expected.groups);
+              EXPECT_EQ(got.valid, 0b111u);
+              for (int g = 0; g < got.groups; ++g) {
+                const MseMatrix m = full(got, g);
+                const double tolerance = 1e-5 * expected.h[size_t(g)].cwiseAbs().maxCoeff() + 1e-9;
+                for (int i = 0; i < 3; ++i)
+                  for (int j = 0; j < 3; ++j)
+                    ASSERT_NEAR(m(i, j), expected.h[size_t(g)](i, j), tolerance)
+                        << "form " << int(form) << " radius " << radius << " relative " << relative
+                        << " outlierCap " << outlierCap << " pixel " << x << "," << y << " entry "
+                        << i << j;
+                // The solver's part h is positive semi-definite.
+                const Eigen::MatrixXd h = got.h[size_t(g)];
+                EXPECT_GE(
+                    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(h).eigenvalues().minCoeff(),
+                    -1e-6 * h.trace());
+              }
             }
-          }
-      }
+        }
 }
 
 // Image mean over pixels of ⟨M⟩ − T, per entry, with T the true half-buffer error matrix
@@ -215,6 +246,9 @@ BiasCheck biasOverSeeds(int radius, bool leaky) {
   MseOptions o;
   o.form = MseForm::PerChannel;
   o.windowRadius = radius;
+  // The outlier cap weighs pixels by their own noisy terms, which trades a bias for robustness
+  // to fireflies: the plain estimator is the unbiased one.
+  o.outlierCap = 0;
   std::vector<double> sum(9, 0.0), sumSq(9, 0.0);
   for (int s = 0; s < kSeeds; ++s) {
     Fixture f = makeFixture(16, 12, 1000 + uint64_t(s));
@@ -269,6 +303,8 @@ TEST(MseEstimate, NonFiniteOutputsAreExcluded) {
   for (int radius : {0, 2}) {
     MseOptions o;
     o.windowRadius = radius;
+    o.outlierCap = 0;   // naiveMse's definition
+    o.consistency = 0;  // only non-finite outputs make a base invalid here
     const MseEstimator estimator(f.guides, pointers(f), o);
     EXPECT_EQ(estimator.at(5, 5).valid, 0b101u);
     EXPECT_EQ(estimator.at(7, 2).valid, 0b011u);
@@ -290,10 +326,34 @@ TEST(MseEstimate, NonFiniteOutputsAreExcluded) {
       Fixture clean = makeFixture(12, 10, 4);
       MseOptions summed;
       summed.windowRadius = 0;
+      summed.outlierCap = 0;
       const PixelMse expected = naiveMse(clean, summed, 5, 5);
       EXPECT_NEAR(full(got, 0)(0, 2), expected.h[0](0, 2), 1e-5 * std::abs(expected.h[0](0, 2)));
     }
   }
+}
+
+// A base whose full-buffer output strays from both of its half outputs (a firefly kept only in
+// the full run) is left out of the solve at that pixel, and only there; the estimate itself,
+// which the neighbours' windows use, is the same with and without the test.
+TEST(MseEstimate, InconsistentFullRunIsLeftOutOfTheSolve) {
+  Fixture f = makeFixture(12, 10, 5);
+  for (int c = 0; c < 3; ++c) f.bases[1].full(4, 4, c) += 20.0f;  // halves: box blurs, ~1
+  f.bases[2].full(8, 6, 0) += 0.05f;                               // within the allowance
+  MseOptions on, off;
+  on.windowRadius = off.windowRadius = 2;
+  off.consistency = 0;
+  const MseEstimator with(f.guides, pointers(f), on), without(f.guides, pointers(f), off);
+  for (int y = 0; y < 10; ++y)
+    for (int x = 0; x < 12; ++x) {
+      const bool stray = x == 4 && y == 4;
+      EXPECT_EQ(with.at(x, y).valid, stray ? 0b101u : 0b111u) << x << "," << y;
+      EXPECT_EQ(without.at(x, y).valid, 0b111u) << x << "," << y;
+      EXPECT_EQ(with.at(x, y).h[0], without.at(x, y).h[0]) << x << "," << y;
+    }
+  // When every base strays the test would leave nothing: all of them stay.
+  for (BaseOutputs& b : f.bases) b.full(4, 4, 0) += 20.0f;
+  EXPECT_EQ(MseEstimator(f.guides, pointers(f), on).at(4, 4).valid, 0b111u);
 }
 
 TEST(MseEstimate, ExtremeScales) {

@@ -9,6 +9,10 @@
 namespace chorus {
 namespace {
 
+// The consistency test's allowance beyond k·|y^A − y^B|/2, as a fraction of mean |x| + |ȳ|:
+// where the halves agree closely the full run may still differ by its smaller noise.
+constexpr double kConsistencyAllowance = 0.1;
+
 bool finite3(const float* v) {
   return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
 }
@@ -75,6 +79,10 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
     : options_(options) {
   checkEnsembleInputs(guides, bases);
   if (options.windowRadius < 0) throw Error("the MSE window radius must be at least 0");
+  if (!(options.outlierCap >= 0) || !std::isfinite(options.outlierCap))
+    throw Error("the MSE outlier cap must be a finite number ≥ 0");
+  if (!(options.consistency >= 0) || !std::isfinite(options.consistency))
+    throw Error("the consistency tolerance must be a finite number ≥ 0");
   width_ = guides.width();
   height_ = guides.height();
   baseCount_ = int(bases.size());
@@ -123,6 +131,26 @@ BaseMask MseEstimator::validAt(size_t pixel) const {
     if (finite) mask |= BaseMask(1) << i;
   }
   return mask;
+}
+
+BaseMask MseEstimator::solvableAt(size_t pixel) const {
+  BaseMask mask = validAt(pixel);
+  const size_t e = pixel * 3;
+  if (!(options_.consistency > 0) || reference_) return mask;
+  BaseMask consistent = 0;
+  for (int i = 0; i < baseCount_; ++i) {
+    if (!((mask >> i) & 1u)) continue;
+    bool close = true;
+    for (int c = 0; c < 3; ++c) {
+      const double a = outA_[size_t(i)][e + size_t(c)], b = outB_[size_t(i)][e + size_t(c)];
+      const double full = outFull_[size_t(i)][e + size_t(c)], mean = 0.5 * (a + b);
+      close =
+          close && std::abs(full - mean) <= options_.consistency * 0.5 * std::abs(a - b) +
+                                                kConsistencyAllowance * (scale_ + std::abs(mean));
+    }
+    if (close) consistent |= BaseMask(1) << i;
+  }
+  return consistent != 0 ? consistent : mask;
 }
 
 std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes) const {
@@ -180,6 +208,13 @@ std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& p
               half * (first[size_t(i)] * first[size_t(j)] + second[size_t(i)] * second[size_t(j)]);
       h[entries] -= half * (xA - xB) * (xA - xB);
     }
+    if (options_.outlierCap > 0 && !reference_) {
+      double trace = 0;
+      for (int g = 0; g < groups(); ++g)
+        for (int i = 0; i < n; ++i) trace += acc[size_t(g * (entries + 1) + packed(i, i, n))];
+      const double factor = options_.outlierCap / (trace + options_.outlierCap);
+      for (int k = 0; k < planeCount(); ++k) acc[size_t(k)] *= factor;
+    }
     bool finite = true;
     for (int k = 0; k < planeCount(); ++k) finite = finite && std::isfinite(float(acc[size_t(k)]));
     if (!finite) continue;
@@ -204,7 +239,7 @@ MseRows MseEstimator::rows(int y0, int y1) const {
   const size_t pixels = size_t(y1 - y0) * size_t(width_);
   out.valid_.resize(pixels);
   for (size_t local = 0; local < pixels; ++local)
-    out.valid_[local] = validAt(size_t(y0) * size_t(width_) + local);
+    out.valid_[local] = solvableAt(size_t(y0) * size_t(width_) + local);
 
   const int r = options_.windowRadius;
   if (r == 0) {

@@ -27,6 +27,17 @@
 // - relative: divide each channel's terms by (μ̂² + ε), μ̂ = the mean of the finite bases'
 //   full-buffer outputs (the oracle: the reference), ε = 0.01, so that the objective targets
 //   relMSE instead of MSE.
+// - outlierCap F: before the window, scale each pixel's terms by F / (t + F), t their trace
+//   (Σ_i H_ii over the groups) in units of (mean |x|)² (relative form: relative units). A
+//   typical pixel keeps about its weight; a firefly's terms, whose noise (the cross terms
+//   −x^A y_i^B with a huge x^A) would otherwise choose the weights of every pixel within the
+//   radius, count about as much as F. 0 = off. Measured: README, "Ensemble options".
+// - consistency k: at a pixel, a base whose full-buffer output lies further than
+//   k·|y^A − y^B|/2 + 0.1·(mean |x| + |ȳ|) from the mean ȳ of its half-buffer outputs in some
+//   channel gets weight 0 (unless every base does). The estimate judges the half-buffer runs;
+//   a full run that behaves unlike both (NL-means variants that keep a firefly the half runs
+//   removed) is outside what it can see. The pixel still enters its neighbours' windows with
+//   every base. 0 = off.
 // Non-finite inputs: a base whose output (A, B or full) is NaN/Inf at a pixel is invalid there
 // (its bit in `valid` is 0; the solver gives it weight 0). A pixel where any base or x^A/x^B is
 // non-finite contributes nothing to its neighbours' windows.
@@ -46,6 +57,8 @@ struct MseOptions {
   MseForm form = MseForm::Summed;
   int windowRadius = 5;
   bool relative = false;
+  double outlierCap = 30.0;
+  double consistency = 4.0;
   float windowSigmaSpatial = 0;  // σ_s in pixels; 0 = the window radius
   float windowSigmaNormal = 0.2f;
   float windowSigmaAlbedo = 0.1f;
@@ -104,6 +117,8 @@ class MseEstimator {
   PixelMse at(int x, int y) const;
   // The bases whose outputs are finite at a pixel (index y·width + x).
   BaseMask validAt(size_t pixel) const;
+  // validAt without the bases that fail the consistency test there: the solver's mask.
+  BaseMask solvableAt(size_t pixel) const;
 
  private:
   MseEstimator(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,

@@ -41,18 +41,20 @@ int main(int argc, char** argv) {
   for (MseForm form : {MseForm::PerChannel, MseForm::Summed})
     for (int radius : radii)
       for (bool relative : {false, true})
-        for (bool filter : {true, false}) {
-          if (quick && !filter) continue;
-          Variant v;
-          v.options.mse.form = form;
-          v.options.mse.windowRadius = radius;
-          v.options.mse.relative = relative;
-          v.options.filter.enabled = filter;
-          v.name = std::string(form == MseForm::PerChannel ? "per-channel" : "summed") +
-                   " r=" + std::to_string(radius) + (relative ? " relative" : " absolute") +
-                   (filter ? " filter" : " nofilter");
-          variants.push_back(v);
-        }
+        for (bool normalize : {false, true})
+          for (bool filter : {true, false}) {
+            if ((quick && !filter) || (normalize && radius == 0)) continue;  // r = 0: same argmin
+            Variant v;
+            v.options.mse.form = form;
+            v.options.mse.windowRadius = radius;
+            v.options.mse.relative = relative;
+            v.options.mse.outlierCap = normalize ? MseOptions{}.outlierCap : 0.0;
+            v.options.filter.enabled = filter;
+            v.name = std::string(form == MseForm::PerChannel ? "per-channel" : "summed") +
+                     " r=" + std::to_string(radius) + (relative ? " relative" : " absolute") +
+                     (normalize ? " capped" : "") + (filter ? " filter" : " nofilter");
+            variants.push_back(v);
+          }
 
   const std::vector<synthetic::Case> cases = synthetic::standardCases();
   // Then every combiner with the default options (the oracle against the truth).
@@ -79,9 +81,9 @@ int main(int argc, char** argv) {
     logBest += std::log(best);
     std::printf("%-28s %10.5f", cases[ci].name.c_str(), best);
     for (size_t vi = 0; vi < variants.size(); ++vi) {
-      const double value = relMse(
-          combine(prepared.guides, bases, variants[vi].options, &prepared.truth).image,
-          prepared.truth);
+      const double value =
+          relMse(combine(prepared.guides, bases, variants[vi].options, &prepared.truth).image,
+                 prepared.truth);
       logSum[vi] += std::log(value);
       wins[vi] += value < best;
       std::printf(" %.5f", value);
@@ -91,7 +93,8 @@ int main(int argc, char** argv) {
   std::printf("\n%-50s %12s %8s\n", "variant", "geomean relMSE", "wins");
   std::printf("%-50s %12.6f\n", "best single base (per case)", std::exp(logBest / cases.size()));
   for (size_t vi = 0; vi < variants.size(); ++vi)
-    std::printf("%s%-50s %12.6f %5d/%zu\n", vi == firstCombiner ? "\n" : "", variants[vi].name.c_str(),
-                std::exp(logSum[vi] / cases.size()), wins[vi], cases.size());
+    std::printf("%s%-50s %12.6f %5d/%zu\n", vi == firstCombiner ? "\n" : "",
+                variants[vi].name.c_str(), std::exp(logSum[vi] / cases.size()), wins[vi],
+                cases.size());
   return 0;
 }

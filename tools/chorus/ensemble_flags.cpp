@@ -21,6 +21,15 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
       ->capture_default_str();
   cmd.add_flag("--relative,!--absolute", relative,
                "Divide the MSE estimate by (mean² + 0.01) so that it targets relMSE");
+  cmd.add_option("--outlier-cap", outlierCap,
+                 "Scale each pixel's MSE terms by F/(trace + F) before the window (trace in units "
+                 "of mean|x|²), so that a firefly counts about as much as F in its neighbours' "
+                 "windows (0 = off)")
+      ->capture_default_str();
+  cmd.add_option("--consistency", consistency,
+                 "Give a base weight 0 where its full-buffer output lies more than K times half "
+                 "the A/B difference (+10%) from the mean of its half outputs (0 = off)")
+      ->capture_default_str();
   cmd.add_option("--solver-seed", seed, "Seed of the pairwise solver")->capture_default_str();
 }
 
@@ -36,6 +45,10 @@ CombineOptions EnsembleFlags::options() const {
   if (window < 0) throw Error("--window must be at least 0");
   o.mse.windowRadius = window;
   o.mse.relative = relative;
+  if (!(outlierCap >= 0)) throw Error("--outlier-cap must be at least 0");
+  if (!(consistency >= 0)) throw Error("--consistency must be at least 0");
+  o.mse.outlierCap = outlierCap;
+  o.mse.consistency = consistency;
   if (weightFilter != "bilateral" && weightFilter != "none")
     throw Error("unknown --weight-filter '" + weightFilter + "' (known: bilateral, none)");
   o.filter.enabled = weightFilter == "bilateral";

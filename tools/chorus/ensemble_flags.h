@@ -13,6 +13,8 @@ struct EnsembleFlags {
   std::string solver = "active-set", weightFilter = "bilateral", mseForm = "summed";
   int window = MseOptions{}.windowRadius;
   bool relative = MseOptions{}.relative;
+  double outlierCap = MseOptions{}.outlierCap;
+  double consistency = MseOptions{}.consistency;
   uint64_t seed = 1;
 
   bool weightFilterGiven = false;  // --weight-filter was on the command line

@@ -49,6 +49,8 @@ nlohmann::ordered_json combineOptionsJson(const CombineOptions& o) {
           {"mse", o.mse.form == MseForm::Summed ? "summed" : "per-channel"},
           {"window", o.mse.windowRadius},
           {"relative", o.mse.relative},
+          {"outlier_cap", o.mse.outlierCap},
+          {"consistency", o.mse.consistency},
           {"weight_filter", o.filter.enabled ? "bilateral" : "none"},
           {"solver_seed", o.seed}};
 }

@@ -90,7 +90,8 @@ std::string sweepSettings(const SweepConfig& config) {
     text << " spp " << config.referenceSpp << " seconds " << config.referenceSeconds;
   text << "\nensemble " << solverName(c.solver) << " "
        << (c.mse.form == MseForm::Summed ? "summed" : "per-channel") << " window "
-       << c.mse.windowRadius << (c.mse.relative ? " relative" : " absolute") << " filter "
+       << c.mse.windowRadius << (c.mse.relative ? " relative" : " absolute") << " outlier-cap "
+       << c.mse.outlierCap << " consistency " << c.mse.consistency << " filter "
        << (c.filter.enabled ? "bilateral" : "none") << " seed " << c.seed << "\ncrop "
        << config.cropSize << "\n";
   return text.str();

@@ -2,21 +2,29 @@
 // N = 4 base outputs, for the default path (MSE window) and per pixel (the paper's form), and
 // prints seconds per megapixel (wall clock, and process CPU time: on a busy machine the CPU
 // time divided by the thread count is the better estimate of the quiet-machine wall time). Base
-// outputs are separable box blurs of a synthetic render (their cost is not measured here). Never
-// run by CTest.
+// outputs are separable box blurs of a synthetic render (their cost is not measured here). The
+// "mse" and "xbf" columns time, in separate passes, the MSE estimate alone (part of "solve") and
+// the joint-bilateral filter of the weights alone (the core of "filter"), wall and CPU; the
+// "digest" column hashes the output image and weights, so that a speed change that should not
+// change results can be checked bit for bit. Never run by CTest.
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <bit>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <ctime>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "denoise/ensemble/combiners.h"
 #include "denoise/ensemble/synthetic_cases.h"
 #include "denoise/metrics/metrics.h"
+#include "denoise/util/stopwatch.h"
 
 namespace {
 using namespace chorus;
@@ -50,14 +58,66 @@ Image boxBlur(const Image& image, int r, float clampValue) {
   return out;
 }
 
+// FNV-1a over the bits of the blend and the final weights.
+uint64_t digest(const CombineResult& result) {
+  uint64_t hash = 1469598103934665603ull;
+  const auto add = [&](const Image& image) {
+    for (float v : image.values()) {
+      hash ^= std::bit_cast<uint32_t>(v);
+      hash *= 1099511628211ull;
+    }
+  };
+  add(result.image);
+  for (const Image& map : result.weights) add(map);
+  return hash;
+}
+
+// Wall and process CPU seconds of a piece of work.
+struct Timing {
+  double wall = 1e30, cpu = 1e30;
+};
+template <typename Work>
+Timing timed(Work&& work) {
+  const std::clock_t cpuStart = std::clock();
+  Stopwatch clock;
+  work();
+  return {clock.seconds(), double(std::clock() - cpuStart) / CLOCKS_PER_SEC};
+}
+
+// The MSE estimate of the whole image in bands, as the solve stage computes it.
+Timing timeMseEstimate(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,
+                       const MseOptions& options) {
+  const MseEstimator estimator(guides, bases, options);
+  constexpr int kBandRows = 16;
+  const int bands = (estimator.height() + kBandRows - 1) / kBandRows;
+  return timed([&] {
+    tbb::parallel_for(0, bands, [&](int band) {
+      const MseRows rows = estimator.rows(band * kBandRows, (band + 1) * kBandRows);
+      (void)rows;
+    });
+  });
+}
+
+// The joint-bilateral filter of the raw weights alone (the core of the filter stage).
+Timing timeWeightFilter(const CombineResult& result, const EnsembleGuides& guides,
+                        const WeightFilterOptions& options) {
+  const ColorGuide guide = makeColorGuide(result.image, result.imageA, result.imageB, options);
+  return timed([&] {
+    const std::vector<Image> filtered =
+        crossBilateralFilter(result.rawWeights, guide, guides.normal, guides.albedo, options);
+  });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"ensemble combination step: seconds per megapixel"};
   int size = 1024, threads = 2, repeats = 3;
+  std::string only;
   app.add_option("--size", size, "image width and height (default 1024: 1 Mpx)");
   app.add_option("--threads", threads, "TBB threads (default 2)");
   app.add_option("--repeats", repeats, "runs per configuration; the fastest is reported");
+  app.add_option("--only", only, "run only the configurations whose name starts with this");
   CLI11_PARSE(app, argc, argv);
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
 
@@ -99,26 +159,35 @@ int main(int argc, char** argv) {
 
   std::printf("%dx%d (%.2f Mpx), N = 4, %d threads, best of %d\n", size, size, megapixels, threads,
               repeats);
-  std::printf("%-48s %8s %8s %8s %9s %9s %9s\n", "configuration", "solve", "filter", "blend",
-              "total s", "s/Mpx", "cpu s/Mpx");
+  std::printf("%-44s %6s %6s %6s %7s %9s | %11s %11s | %s\n", "configuration (seconds)", "solve",
+              "filter", "blend", "s/Mpx", "cpu s/Mpx", "mse wall/cpu", "xbf wall/cpu", "digest");
   for (const Config& config : configs) {
+    if (config.name.rfind(only, 0) != 0) continue;
     double best = 1e30, solve = 0, filter = 0, blendTime = 0, cpu = 0;
+    Timing mse, bilateral;
+    uint64_t hash = 0;
     for (int r = 0; r < repeats; ++r) {
-      const std::clock_t cpuStart = std::clock();
-      const CombineResult result = combine(guides, pointers, config.options);
-      const double cpuSeconds = double(std::clock() - cpuStart) / CLOCKS_PER_SEC;
+      const Timing m = timeMseEstimate(guides, pointers, config.options.mse);
+      if (m.wall < mse.wall) mse = m;
+      CombineResult result;
+      const Timing all = timed([&] { result = combine(guides, pointers, config.options); });
       double total = 0;
       for (const StageTime& t : result.times) total += t.seconds;
       if (total < best) {
         best = total;
-        cpu = cpuSeconds;
+        cpu = all.cpu;
         solve = result.times[0].seconds;
         filter = result.times[1].seconds;
         blendTime = result.times[2].seconds;
       }
+      const Timing b = timeWeightFilter(result, guides, config.options.filter);
+      if (b.wall < bilateral.wall) bilateral = b;
+      hash = digest(result);
     }
-    std::printf("%-48s %8.3f %8.3f %8.3f %9.3f %9.3f %9.3f\n", config.name.c_str(), solve, filter,
-                blendTime, best, best / megapixels, cpu / megapixels);
+    std::printf("%-44s %6.3f %6.3f %6.3f %7.3f %9.3f | %5.3f/%5.3f %5.3f/%5.3f | %016llx\n",
+                config.name.c_str(), solve, filter, blendTime, best / megapixels, cpu / megapixels,
+                mse.wall, mse.cpu, bilateral.wall, bilateral.cpu,
+                static_cast<unsigned long long>(hash));
   }
   return 0;
 }

@@ -1,6 +1,7 @@
 #include "denoise/ensemble/planar_filter.h"
 
 #include <algorithm>
+#include <cstring>
 
 #include "denoise/util/fast_exp.h"
 #include "denoise/util/simd_clones.h"
@@ -10,128 +11,289 @@ namespace {
 
 constexpr float kVarianceFloor = 1e-6f;
 
-// Kernel values k[i] for the pixels x = x0 + i (i < count) of row y and offset (dx, dy): the
-// distances first (a loop that vectorises), then their exponentials.
-// Pointers start at p = (x0, y) and q = (x0 + dx, y + dy); plain int indexing so that the
-// loops vectorise.
-CHORUS_SIMD_CLONES void kernelRow(const PlanarGuides& g, const BilateralKernel& kernel, int y, int dx, int dy, int x0,
-               int count, float* __restrict k) {
+// Sixteen floats: one AVX-512 register, two AVX2 or four SSE registers (each clone picks).
+constexpr int kLanes = 16;
+typedef float Lanes __attribute__((vector_size(kLanes * sizeof(float))));
+// Tile width in columns (a multiple of kLanes): wide, so that few kernel values are computed
+// twice at tile edges; small enough that the tile's buffers stay in L2.
+constexpr int kBlock = 256;
+
+// The guide values of a run of kLanes pixel pairs: plane m of p at p[m], of q at q[m]
+// (m = 0…2 normal, 3…5 albedo, 6…8 colour, 9…11 variance).
+struct GuideLanes {
+  const float* p[12];
+  const float* q[12];
+};
+
+// Kernel values k[l] = k(p_l, q_l), l < kLanes: fixed-length loops, so that every pair is
+// computed by the same vector code whatever its position in a row.
+template <bool kColor>
+[[gnu::always_inline]] inline void kernelLanes(const GuideLanes& g, float spatial,
+                                               const BilateralKernel& kernel, float* k) {
+  const float kn = kernel.kNormal, ka = kernel.kAlbedo, kc = kernel.kColor;
+  float e[kLanes];
+  for (int l = 0; l < kLanes; ++l) {
+    const float dn0 = g.p[0][l] - g.q[0][l], dn1 = g.p[1][l] - g.q[1][l],
+                dn2 = g.p[2][l] - g.q[2][l];
+    const float da0 = g.p[3][l] - g.q[3][l], da1 = g.p[4][l] - g.q[4][l],
+                da2 = g.p[5][l] - g.q[5][l];
+    float d = spatial + kn * (dn0 * dn0 + dn1 * dn1 + dn2 * dn2) +
+              ka * (da0 * da0 + da1 * da1 + da2 * da2);
+    if (kColor) {
+      const float dz0 = g.p[6][l] - g.q[6][l], dz1 = g.p[7][l] - g.q[7][l],
+                  dz2 = g.p[8][l] - g.q[8][l];
+      // Σ_c dz_c²/s_c with one division: (a·s1·s2 + b·s0·s2 + c·s0·s1) / (s0·s1·s2); the
+      // guide's bounds (|z| ≤ 1e6, V ≤ 1e12) keep every product finite.
+      const float s0 = g.p[9][l] + g.q[9][l] + kVarianceFloor,
+                  s1 = g.p[10][l] + g.q[10][l] + kVarianceFloor,
+                  s2 = g.p[11][l] + g.q[11][l] + kVarianceFloor;
+      d = d + kc * ((dz0 * dz0 * (s1 * s2) + dz1 * dz1 * (s0 * s2) + dz2 * dz2 * (s0 * s1)) /
+                    (s0 * s1 * s2));
+    }
+    e[l] = d;
+  }
+  for (int l = 0; l < kLanes; ++l) k[l] = fastExpNonPositive(-e[l]);
+}
+
+// Kernel values k[i] for the pixels x = x0 + i (i < count) of row y and offset (dx, dy). Writes
+// whole runs of kLanes: k must have room for count rounded up to kLanes (the values past count
+// are unspecified). A last partial run is read in place where the guide planes extend far
+// enough, else from a zero-padded copy.
+template <bool kColor>
+[[gnu::always_inline]] inline void kernelRowOf(const PlanarGuides& g, const BilateralKernel& kernel,
+                                               int y, int dx, int dy, int x0, int count, float* k) {
   const size_t pixels = size_t(g.width) * size_t(g.height);
   const size_t rowP = size_t(y) * size_t(g.width) + size_t(x0);
   const size_t rowQ = size_t(y + dy) * size_t(g.width) + size_t(x0 + dx);
   const float spatial = kernel.kSpatial * float(dx * dx + dy * dy);
-  const float kn = kernel.kNormal, ka = kernel.kAlbedo, kc = kernel.kColor;
-  const float *n0p = g.normal.data() + rowP, *n1p = n0p + pixels, *n2p = n1p + pixels;
-  const float *n0q = g.normal.data() + rowQ, *n1q = n0q + pixels, *n2q = n1q + pixels;
-  const float *a0p = g.albedo.data() + rowP, *a1p = a0p + pixels, *a2p = a1p + pixels;
-  const float *a0q = g.albedo.data() + rowQ, *a1q = a0q + pixels, *a2q = a1q + pixels;
-  if (kc > 0) {
-    const float *z0p = g.color.data() + rowP, *z1p = z0p + pixels, *z2p = z1p + pixels;
-    const float *z0q = g.color.data() + rowQ, *z1q = z0q + pixels, *z2q = z1q + pixels;
-    const float *v0p = g.variance.data() + rowP, *v1p = v0p + pixels, *v2p = v1p + pixels;
-    const float *v0q = g.variance.data() + rowQ, *v1q = v0q + pixels, *v2q = v1q + pixels;
-    for (int i = 0; i < count; ++i) {
-      const float dn0 = n0p[i] - n0q[i], dn1 = n1p[i] - n1q[i], dn2 = n2p[i] - n2q[i];
-      const float da0 = a0p[i] - a0q[i], da1 = a1p[i] - a1q[i], da2 = a2p[i] - a2q[i];
-      const float dz0 = z0p[i] - z0q[i], dz1 = z1p[i] - z1q[i], dz2 = z2p[i] - z2q[i];
-      // Σ_c dz_c²/s_c with one division: (a·s1·s2 + b·s0·s2 + c·s0·s1) / (s0·s1·s2); the
-      // guide's bounds (|z| ≤ 1e6, V ≤ 1e12) keep every product finite.
-      const float s0 = v0p[i] + v0q[i] + kVarianceFloor, s1 = v1p[i] + v1q[i] + kVarianceFloor,
-                  s2 = v2p[i] + v2q[i] + kVarianceFloor;
-      const float color =
-          (dz0 * dz0 * (s1 * s2) + dz1 * dz1 * (s0 * s2) + dz2 * dz2 * (s0 * s1)) / (s0 * s1 * s2);
-      k[i] = (spatial + kn * (dn0 * dn0 + dn1 * dn1 + dn2 * dn2) +
-              ka * (da0 * da0 + da1 * da1 + da2 * da2) + kc * color);
+  const std::vector<float>* planes[4] = {&g.normal, &g.albedo, &g.color, &g.variance};
+  const int planeCount = kColor ? 12 : 6;
+  GuideLanes run;
+  for (int m = 0; m < planeCount; ++m) {
+    const float* base = planes[m / 3]->data() + size_t(m % 3) * pixels;
+    run.p[m] = base + rowP;
+    run.q[m] = base + rowQ;
+  }
+  int i = 0;
+  for (; i + kLanes <= count; i += kLanes) {
+    kernelLanes<kColor>(run, spatial, kernel, k + i);
+    for (int m = 0; m < planeCount; ++m) run.p[m] += kLanes, run.q[m] += kLanes;
+  }
+  if (i == count) return;
+  if (std::max(rowP, rowQ) + size_t(i + kLanes) <= pixels) {
+    kernelLanes<kColor>(run, spatial, kernel, k + i);
+    return;
+  }
+  float padded[2][12][kLanes] = {};
+  for (int m = 0; m < planeCount; ++m) {
+    std::copy(run.p[m], run.p[m] + (count - i), padded[0][m]);
+    std::copy(run.q[m], run.q[m] + (count - i), padded[1][m]);
+    run.p[m] = padded[0][m];
+    run.q[m] = padded[1][m];
+  }
+  kernelLanes<kColor>(run, spatial, kernel, k + i);
+}
+
+CHORUS_SIMD_CLONES_EXACT void kernelRow(const PlanarGuides& g, const BilateralKernel& kernel, int y,
+                                        int dx, int dy, int x0, int count, float* k) {
+  if (kernel.kColor > 0)
+    kernelRowOf<true>(g, kernel, y, dx, dy, x0, count, k);
+  else
+    kernelRowOf<false>(g, kernel, y, dx, dy, x0, count, k);
+}
+
+// One tile of the output (rows [y0, y1), columns [x0, x0 + width)) and its buffers, all rows
+// of `stride` floats starting at column x0 − r:
+//   source: plane j, rows y0 − r … y1 + r − 1 (zeros outside the image),
+//   kernel: per dx of the current row of offsets dy, a ring of dy + 1 rows: k(s, s + δ) for the
+//           last rows s computed (0 where s or s + δ is outside the image),
+//   acc:    plane 0 the weight sum Σk, plane 1 + j the weighted sum of plane j; rows y0 … y1 − 1
+//           of `width` floats from column x0.
+struct Tile {
+  int rows, width, stride, r;
+  const float* source;
+  size_t sourcePlane;
+  const float* kernel;
+  size_t kernelPlane;
+  float* acc;
+  size_t accPlane;
+};
+
+// Unaligned loads and stores through references (a vector returned by value would change the
+// ABI of the baseline clone).
+[[gnu::always_inline]] inline void loadLanes(Lanes& v, const float* p) {
+  std::memcpy(&v, p, sizeof v);
+}
+[[gnu::always_inline]] inline void storeLanes(float* p, const Lanes& v) {
+  std::memcpy(p, &v, sizeof v);
+}
+
+// Where one output row finds its terms for the row of offsets dy: tile row y, and the kernel
+// ring slots of the rows s = y (for q = p + δ) and s = y − dy (for q = p − δ).
+struct RowTerms {
+  int y, dy, dxLo, plusSlot, minusSlot;
+};
+
+// Adds the offsets (dx, dy), dx = dxLo … r, to kLanes accumulators of planes j0 … j0 + G − 1
+// (and of the weight sum when kSum) at column col. Per offset the terms are added in the order
+// of the definition — q = p + δ, then q = p − δ — so the accumulators in registers give the
+// same bits as a pass over memory per offset.
+template <int G, bool kSum>
+[[gnu::always_inline]] inline void accumulateLanes(const Tile& t, const RowTerms& row, int j0,
+                                                   int col) {
+  const size_t accAt = size_t(row.y) * size_t(t.width) + size_t(col);
+  Lanes sum{}, acc[G];
+  if (kSum) loadLanes(sum, t.acc + accAt);
+#pragma GCC unroll 16
+  for (int g = 0; g < G; ++g) loadLanes(acc[g], t.acc + size_t(1 + j0 + g) * t.accPlane + accAt);
+  const float* source = t.source + size_t(j0) * t.sourcePlane;
+  const size_t plusRow = size_t(row.y + row.dy + t.r) * size_t(t.stride);
+  const size_t minusRow = size_t(row.y - row.dy + t.r) * size_t(t.stride);
+  const float* kPlusRow = t.kernel + size_t(row.plusSlot) * size_t(t.stride) + size_t(col + t.r);
+  const float* kMinusRow = t.kernel + size_t(row.minusSlot) * size_t(t.stride) + size_t(col + t.r);
+  for (int dx = row.dxLo; dx <= t.r; ++dx) {
+    // k(p, p + δ) is stored at s = p, k(p − δ, p) at s = p − δ.
+    const size_t plane = size_t(dx + t.r) * t.kernelPlane;
+    Lanes kPlus, kMinus;
+    loadLanes(kPlus, kPlusRow + plane);
+    loadLanes(kMinus, kMinusRow + plane - dx);
+    if (kSum) {
+      sum += kPlus;
+      sum += kMinus;
     }
-  } else {
-    for (int i = 0; i < count; ++i) {
-      const float dn0 = n0p[i] - n0q[i], dn1 = n1p[i] - n1q[i], dn2 = n2p[i] - n2q[i];
-      const float da0 = a0p[i] - a0q[i], da1 = a1p[i] - a1q[i], da2 = a2p[i] - a2q[i];
-      k[i] = (spatial + kn * (dn0 * dn0 + dn1 * dn1 + dn2 * dn2) +
-              ka * (da0 * da0 + da1 * da1 + da2 * da2));
+    const size_t plus = plusRow + size_t(col + dx + t.r), minus = minusRow + size_t(col - dx + t.r);
+#pragma GCC unroll 16
+    for (int g = 0; g < G; ++g) {
+      const float* s = source + size_t(g) * t.sourcePlane;
+      Lanes qPlus, qMinus;
+      loadLanes(qPlus, s + plus);
+      loadLanes(qMinus, s + minus);
+      acc[g] += kPlus * qPlus;
+      acc[g] += kMinus * qMinus;
     }
   }
-  fastExpNegated(k, k, count);
+  if (kSum) storeLanes(t.acc + accAt, sum);
+#pragma GCC unroll 16
+  for (int g = 0; g < G; ++g) storeLanes(t.acc + size_t(1 + j0 + g) * t.accPlane + accAt, acc[g]);
+}
+
+// Adds the row of offsets dy to the accumulators of one output row, planes in groups of up to
+// 8 (the weight sum with the first group) so that a group's accumulators stay in registers
+// while the offsets are looped.
+CHORUS_SIMD_CLONES_EXACT void accumulateRow(const Tile& t, int planes, const RowTerms& row) {
+  for (int col = 0; col < t.width; col += kLanes)
+    for (int j = 0; j < planes;) {
+      const int left = planes - j;
+      const bool first = j == 0;
+      if (left >= 8) {
+        first ? accumulateLanes<8, true>(t, row, j, col)
+              : accumulateLanes<8, false>(t, row, j, col);
+        j += 8;
+      } else if (left >= 4) {
+        first ? accumulateLanes<4, true>(t, row, j, col)
+              : accumulateLanes<4, false>(t, row, j, col);
+        j += 4;
+      } else if (left >= 2) {
+        first ? accumulateLanes<2, true>(t, row, j, col)
+              : accumulateLanes<2, false>(t, row, j, col);
+        j += 2;
+      } else {
+        first ? accumulateLanes<1, true>(t, row, j, col)
+              : accumulateLanes<1, false>(t, row, j, col);
+        j += 1;
+      }
+    }
 }
 
 }  // namespace
 
-CHORUS_SIMD_CLONES void filterPlaneRows(const PlanarGuides& guides,
-                                        const BilateralKernel& kernel,
-                                        std::span<const float* const> in, int inY0, int y0,
-                                        int y1, std::span<float* const> out) {
+void filterPlaneRows(const PlanarGuides& guides, const BilateralKernel& kernel,
+                     std::span<const float* const> in, int inY0, int y0, int y1,
+                     std::span<float* const> out) {
   const int w = guides.width, h = guides.height, r = std::max(0, kernel.radius);
-  const size_t planes = in.size();
+  const int planes = int(in.size());
+  const int rows = y1 - y0;
+  if (planes == 0 || rows <= 0) return;
   // The kernel is symmetric, k(s, s+δ) = k(s+δ, s) bit for bit, so it is evaluated once per
   // pair for the offsets δ of one half-plane and applied in both directions. Every output value
-  // still receives its terms in one fixed order (centre, then per δ: q = p + δ, q = p − δ), so
-  // results do not depend on how the image is cut into tiles. Tiles are column blocks of the
-  // requested rows, small enough for the accumulators to stay in cache.
-  constexpr int kBlock = 128;
-  const int rows = y1 - y0;
-  const int stride = kBlock + 2 * r;  // kernel buffer row: columns bx0 − r … bx1 + r
-  std::vector<float> k(size_t(rows + r) * size_t(stride));
-  std::vector<float> weightSum(size_t(rows) * kBlock), acc(planes * size_t(rows) * kBlock);
-  const auto inRow = [&](size_t j, int y) { return in[j] + size_t(y - inY0) * size_t(w); };
-  for (int bx0 = 0; bx0 < w; bx0 += kBlock) {
-    const int bx1 = std::min(w, bx0 + kBlock), bw = bx1 - bx0;
-    // Centre tap: k(p, p) = exp(0) = 1.
-    for (int y = y0; y < y1; ++y) {
-      float* sum = weightSum.data() + size_t(y - y0) * kBlock;
-      for (int i = 0; i < bw; ++i) sum[i] = 1.0f;
-      for (size_t j = 0; j < planes; ++j) {
-        const float* src = inRow(j, y) + bx0;
-        float* dst = acc.data() + (j * size_t(rows) + size_t(y - y0)) * kBlock;
-        for (int i = 0; i < bw; ++i) dst[i] = src[i];
+  // receives its terms in one fixed order (centre, then per δ: q = p + δ, q = p − δ; a pair
+  // with q outside the image adds k = 0 times a source 0, which changes no bit), so results do
+  // not depend on how the image is cut into tiles or rows.
+  // Kernel rows are written in whole runs of kLanes (kernelRow): one run of slack.
+  const int stride = kBlock + 2 * r + kLanes;
+  std::vector<float> source(size_t(planes) * size_t(rows + 2 * r) * size_t(stride));
+  std::vector<float> k(size_t(2 * r + 1) * size_t(r + 1) * size_t(stride));
+  std::vector<float> acc(size_t(planes + 1) * size_t(rows) * size_t(kBlock));
+  Tile tile;
+  tile.rows = rows;
+  tile.stride = stride;
+  tile.r = r;
+  tile.source = source.data();
+  tile.sourcePlane = size_t(rows + 2 * r) * size_t(stride);
+  tile.kernel = k.data();
+  tile.kernelPlane = size_t(r + 1) * size_t(stride);
+  tile.acc = acc.data();
+  tile.accPlane = size_t(rows) * size_t(kBlock);
+  for (int x0 = 0; x0 < w; x0 += kBlock) {
+    const int x1 = std::min(w, x0 + kBlock);
+    // Whole lane chunks; columns from x1 on are computed on zeros and not written out.
+    const int width = (x1 - x0 + kLanes - 1) / kLanes * kLanes;
+    tile.width = width;
+
+    // Source planes with a zero border; the centre tap k(p, p) = 1 starts the sums.
+    const int cx0 = std::max(0, x0 - r), cx1 = std::min(w, x1 + r);
+    for (int j = 0; j < planes; ++j)
+      for (int y = y0 - r; y < y1 + r; ++y) {
+        float* dst =
+            source.data() + size_t(j) * tile.sourcePlane + size_t(y - (y0 - r)) * size_t(stride);
+        std::fill(dst, dst + stride, 0.0f);
+        if (y < 0 || y >= h) continue;
+        const float* src = in[size_t(j)] + size_t(y - inY0) * size_t(w);
+        std::copy(src + cx0, src + cx1, dst + (cx0 - (x0 - r)));
       }
+    for (int y = 0; y < rows; ++y) {
+      std::fill_n(acc.data() + size_t(y) * size_t(width), width, 1.0f);
+      for (int j = 0; j < planes; ++j)
+        std::copy_n(source.data() + size_t(j) * tile.sourcePlane + size_t(y + r) * size_t(stride) +
+                        size_t(r),
+                    width, acc.data() + size_t(j + 1) * tile.accPlane + size_t(y) * size_t(width));
     }
+
+    // Per row of offsets dy, kernel rows s = y0 − dy … y1 − 1 in turn; output row y takes its
+    // terms once kernel row s = y exists (row y − dy is still in the ring).
     for (int dy = 0; dy <= r; ++dy) {
-      for (int dx = dy == 0 ? 1 : -r; dx <= r; ++dx) {
-        // Pairs (s, s + δ) with s or s + δ in the tile and both inside the image.
-        const int sy0 = std::max(0, y0 - dy), sy1 = std::min(y1, h - dy);
-        const int sx0 = std::max({0, -dx, std::min(bx0, bx0 - dx)});
-        const int sx1 = std::min({w, w - dx, std::max(bx1, bx1 - dx)});
-        if (sy0 >= sy1 || sx0 >= sx1) continue;
-        // k buffer: row sy − sy0, column sx − (bx0 − r).
-        const int kx0 = sx0 - (bx0 - r);
-        for (int sy = sy0; sy < sy1; ++sy)
-          kernelRow(guides, kernel, sy, dx, dy, sx0, sx1 - sx0,
-                    k.data() + size_t(sy - sy0) * size_t(stride) + size_t(kx0));
-        // p = s, q = p + δ: rows y ∈ [y0, y1) ∩ [sy0, sy1), columns x ∈ [bx0, bx1) ∩ [sx0, sx1).
-        const int px0 = std::max(bx0, sx0), px1 = std::min(bx1, sx1);
-        for (int y = std::max(y0, sy0); y < std::min(y1, sy1) && px0 < px1; ++y) {
-          const float* kp = k.data() + size_t(y - sy0) * size_t(stride) + size_t(px0 - (bx0 - r));
-          const int count = px1 - px0, offset = px0 - bx0;
-          float* sum = weightSum.data() + size_t(y - y0) * kBlock + size_t(offset);
-          for (int i = 0; i < count; ++i) sum[i] += kp[i];
-          for (size_t j = 0; j < planes; ++j) {
-            const float* src = inRow(j, y + dy) + (px0 + dx);
-            float* dst = acc.data() + (j * size_t(rows) + size_t(y - y0)) * kBlock + size_t(offset);
-            for (int i = 0; i < count; ++i) dst[i] += kp[i] * src[i];
+      const int dxLo = dy == 0 ? 1 : -r;
+      if (dxLo > r) continue;
+      for (int sy = y0 - dy; sy < y1; ++sy) {
+        const int slot = (sy - (y0 - dy)) % (dy + 1);
+        for (int dx = dxLo; dx <= r; ++dx) {
+          // Kernel row s is read at columns x0 − max(dx, 0) … x0 + width + max(−dx, 0) − 1;
+          // pairs with s and s + δ in the image are evaluated, the rest is 0.
+          float* row = k.data() + size_t(dx + r) * tile.kernelPlane + size_t(slot) * size_t(stride);
+          const auto at = [&](int x) { return row + (x - (x0 - r)); };
+          const int need0 = x0 - std::max(dx, 0), need1 = x0 + width + std::max(-dx, 0);
+          const int valid0 = std::max({need0, 0, -dx});
+          const int valid1 = std::min({need1, x1 + std::max(-dx, 0), w, w - dx});
+          if (!(sy >= 0 && sy + dy < h && valid0 < valid1)) {
+            std::fill(at(need0), at(need1), 0.0f);
+            continue;
           }
+          std::fill(at(need0), at(valid0), 0.0f);
+          kernelRow(guides, kernel, sy, dx, dy, valid0, valid1 - valid0, at(valid0));
+          std::fill(at(valid1), at(need1), 0.0f);
         }
-        // p = s + δ, q = p − δ: s rows y − dy ∈ [sy0, sy1), columns x − dx ∈ [sx0, sx1).
-        const int mx0 = std::max(bx0, sx0 + dx), mx1 = std::min(bx1, sx1 + dx);
-        for (int y = std::max(y0, sy0 + dy); y < std::min(y1, sy1 + dy) && mx0 < mx1; ++y) {
-          const float* km =
-              k.data() + size_t(y - dy - sy0) * size_t(stride) + size_t(mx0 - dx - (bx0 - r));
-          const int count = mx1 - mx0, offset = mx0 - bx0;
-          float* sum = weightSum.data() + size_t(y - y0) * kBlock + size_t(offset);
-          for (int i = 0; i < count; ++i) sum[i] += km[i];
-          for (size_t j = 0; j < planes; ++j) {
-            const float* src = inRow(j, y - dy) + (mx0 - dx);
-            float* dst = acc.data() + (j * size_t(rows) + size_t(y - y0)) * kBlock + size_t(offset);
-            for (int i = 0; i < count; ++i) dst[i] += km[i] * src[i];
-          }
-        }
+        if (sy < y0) continue;
+        const RowTerms terms{sy - y0, dy, dxLo, slot, (sy - dy - (y0 - dy)) % (dy + 1)};
+        accumulateRow(tile, planes, terms);
       }
     }
-    for (int y = y0; y < y1; ++y) {
-      const float* sum = weightSum.data() + size_t(y - y0) * kBlock;
-      for (size_t j = 0; j < planes; ++j) {
-        float* dst = out[j] + size_t(y - y0) * size_t(w) + size_t(bx0);
-        const float* src = acc.data() + (j * size_t(rows) + size_t(y - y0)) * kBlock;
-        for (int i = 0; i < bw; ++i) dst[i] = src[i] / sum[i];
+
+    for (int y = 0; y < rows; ++y) {
+      const float* sum = acc.data() + size_t(y) * size_t(width);
+      for (int j = 0; j < planes; ++j) {
+        float* dst = out[size_t(j)] + size_t(y) * size_t(w) + size_t(x0);
+        const float* src = acc.data() + size_t(j + 1) * tile.accPlane + size_t(y) * size_t(width);
+        for (int i = 0; i < x1 - x0; ++i) dst[i] = src[i] / sum[i];
       }
     }
   }

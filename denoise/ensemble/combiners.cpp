@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <array>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -52,21 +53,32 @@ SolvedWeights solveWeights(const MseEstimator& estimator, SolverKind solver,
   tbb::parallel_for(0, bands, [&](int band) {
     const MseRows rows = estimator.rows(band * kBandRows, (band + 1) * kBandRows);
     PixelMse pixel;
-    for (int y = rows.y0(); y < rows.y1(); ++y)
+    for (int y = rows.y0(); y < rows.y1(); ++y) {
+      // The active set starts from the left neighbour's support (neighbouring optima usually
+      // share it; the solver keeps the result independent of the start), from scratch at the
+      // start of each row.
+      std::array<BaseMask, 3> support;
+      support.fill(~BaseMask(0));
       for (int x = 0; x < w; ++x) {
         rows.pixel(x, y, pixel);
         const size_t p = size_t(y) * size_t(w) + size_t(x);
         solved.valid[p] = pixel.valid;
         for (int g = 0; g < groups; ++g) {
-          const WeightVector weights =
-              solver == SolverKind::ActiveSet
-                  ? solveSimplexQp(pixel.h[size_t(g)], pixel.valid, qp).weights
-                  : solvePairwise(pixel.h[size_t(g)], seed, p * size_t(groups) + size_t(g),
-                                  pixel.valid)
-                        .weights;
+          WeightVector weights;
+          if (solver == SolverKind::ActiveSet) {
+            SimplexQpResult result =
+                solveSimplexQp(pixel.h[size_t(g)], pixel.valid, qp, support[size_t(g)]);
+            weights = result.weights;
+            support[size_t(g)] = result.support;
+          } else {
+            weights =
+                solvePairwise(pixel.h[size_t(g)], seed, p * size_t(groups) + size_t(g), pixel.valid)
+                    .weights;
+          }
           for (int i = 0; i < n; ++i) solved.weights[size_t(i)](x, y, g) = float(weights[i]);
         }
       }
+    }
   });
   return solved;
 }

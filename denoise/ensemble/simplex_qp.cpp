@@ -15,6 +15,9 @@ using KktMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxK
 constexpr double kNegligibleTangent = 1e-13;
 // Optimality tolerances in normalised units (tangent eigenvalues average 1, weights in [0, 1]).
 constexpr double kMultiplierTolerance = 1e-11;
+// A warm-started solution is kept when every bound weight's multiplier exceeds this: far above
+// both the tolerance and what the ridge (ρ = 1e-8 by default) can decide.
+constexpr double kClearMultiplier = 1e-6;
 
 // The equality-constrained sub-problem on the free set F (other weights fixed at 0):
 //   min ½ w_Fᵀ Q_FF w_F  s.t.  Σ w_F = 1   ⇔   [Q_FF −1; 1ᵀ 0] [w_F; λ] = [0; 1],
@@ -76,16 +79,27 @@ WeightVector uniformOver(int n, BaseMask mask) {
 }
 
 // Primal active-set method (Nocedal & Wright, Numerical Optimization, §16.5) for
-// min ½ wᵀQw on the simplex, started from uniform weights (feasible). Q is the normalised,
-// ridged matrix of the valid bases. Each step solves the equality-constrained problem on the
-// free set, walks towards its solution until a weight hits 0 (which then becomes bound), and
-// at a sub-problem optimum releases the bound weight with the most negative multiplier.
-WeightVector activeSet(const MseMatrix& q, bool nonNegative, int& iterations) {
+// min ½ wᵀQw on the simplex, started from uniform weights over the bases `isFree` (feasible; all
+// bases when the caller has no better guess). Q is the normalised, ridged matrix of the valid
+// bases. Each step solves the equality-constrained problem on the free set, walks towards its
+// solution until a weight hits 0 (which then becomes bound), and at a sub-problem optimum
+// releases the bound weight with the most negative multiplier. On return isFree holds the free
+// set at the optimum and smallestMultiplier the least multiplier of a bound weight (+∞ if none).
+WeightVector activeSet(const MseMatrix& q, bool nonNegative,
+                       std::array<bool, kMaxDenoisers>& isFree, int& iterations,
+                       double& smallestMultiplier) {
   const int m = int(q.rows());
-  WeightVector w = WeightVector::Constant(m, 1.0 / m);
+  int startCount = 0;
+  for (int i = 0; i < m; ++i) startCount += isFree[size_t(i)];
+  if (startCount == 0 || !nonNegative) {
+    for (int i = 0; i < m; ++i) isFree[size_t(i)] = true;
+    startCount = m;
+  }
+  smallestMultiplier = std::numeric_limits<double>::infinity();
+  WeightVector w = WeightVector::Zero(m);
+  for (int i = 0; i < m; ++i)
+    if (isFree[size_t(i)]) w[i] = 1.0 / startCount;
   WeightVector target = WeightVector::Zero(m);
-  std::array<bool, kMaxDenoisers> isFree{};
-  for (int i = 0; i < m; ++i) isFree[size_t(i)] = true;
   double lambda = 0.0;
   bool atSubspaceOptimum = false;
   const int maxIterations = 8 * (m + 2);
@@ -128,9 +142,11 @@ WeightVector activeSet(const MseMatrix& q, bool nonNegative, int& iterations) {
     // KKT multipliers of the bound weights: μ_i = (Qw)_i − λ must be ≥ 0.
     int release = -1;
     double mostNegative = -kMultiplierTolerance;
+    smallestMultiplier = std::numeric_limits<double>::infinity();
     for (int i = 0; i < m; ++i) {
       if (isFree[size_t(i)]) continue;
       const double mu = q.row(i).dot(w) - lambda;
+      smallestMultiplier = std::min(smallestMultiplier, mu);
       if (mu < mostNegative) mostNegative = mu, release = i;
     }
     if (release < 0) break;
@@ -138,6 +154,28 @@ WeightVector activeSet(const MseMatrix& q, bool nonNegative, int& iterations) {
     atSubspaceOptimum = false;
   }
   return w;
+}
+
+// Whether vᵀAv > 0 for every v ≠ 0 with Σv = 0: a Cholesky factorisation of A in the basis
+// e_i − e_last of the tangent space. Only then is the minimiser on the simplex unique.
+bool positiveOnTangent(const MseMatrix& a) {
+  const int m = int(a.rows()) - 1;
+  std::array<std::array<double, kMaxDenoisers>, kMaxDenoisers> b;
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j <= i; ++j) b[size_t(i)][size_t(j)] = a(i, j) - a(i, m) - a(m, j) + a(m, m);
+  for (int k = 0; k < m; ++k) {
+    double d = b[size_t(k)][size_t(k)];
+    for (int p = 0; p < k; ++p) d -= b[size_t(k)][size_t(p)] * b[size_t(k)][size_t(p)];
+    if (!(d > 0.0)) return false;
+    d = std::sqrt(d);
+    b[size_t(k)][size_t(k)] = d;
+    for (int i = k + 1; i < m; ++i) {
+      double v = b[size_t(i)][size_t(k)];
+      for (int p = 0; p < k; ++p) v -= b[size_t(i)][size_t(p)] * b[size_t(k)][size_t(p)];
+      b[size_t(i)][size_t(k)] = v / d;
+    }
+  }
+  return true;
 }
 
 }  // namespace
@@ -171,8 +209,8 @@ BaseMask finiteBases(const MseMatrix& m, BaseMask valid) {
   }
 }
 
-SimplexQpResult solveSimplexQp(const MseMatrix& m, BaseMask valid,
-                               const SimplexQpOptions& options) {
+SimplexQpResult solveSimplexQp(const MseMatrix& m, BaseMask valid, const SimplexQpOptions& options,
+                               BaseMask start) {
   const int n = int(m.rows());
   SimplexQpResult result;
   const BaseMask mask = finiteBases(m, valid);
@@ -219,7 +257,25 @@ SimplexQpResult solveSimplexQp(const MseMatrix& m, BaseMask valid,
   a /= scale;
   a.diagonal().array() += options.relativeRidge;
 
-  WeightVector w = activeSet(a, options.nonNegative, result.iterations);
+  // A warm start must not change the result, so it is taken only where the minimiser is unique
+  // (float-stored estimates of nearly identical outputs can be slightly indefinite on the
+  // tangent space; there the active set may end, or cycle, elsewhere), and kept only if every
+  // bound weight's multiplier is clearly positive: a multiplier within the solver's tolerance
+  // (as for a duplicated base, whose share the ridge decides by only ρ·w) could have gone
+  // either way, and the cold start is what decides it.
+  std::array<bool, kMaxDenoisers> isFree{};
+  double smallestMultiplier = 0.0;
+  WeightVector w;
+  if ((start & mask) != mask && positiveOnTangent(a)) {
+    for (int k = 0; k < count; ++k) isFree[size_t(k)] = (start >> index[size_t(k)]) & 1u;
+    w = activeSet(a, options.nonNegative, isFree, result.iterations, smallestMultiplier);
+  }
+  if (!(smallestMultiplier > kClearMultiplier)) {
+    const int warmIterations = result.iterations;
+    for (int k = 0; k < count; ++k) isFree[size_t(k)] = true;
+    w = activeSet(a, options.nonNegative, isFree, result.iterations, smallestMultiplier);
+    result.iterations += warmIterations;
+  }
 
   // Back to all n bases, exactly on the simplex.
   result.weights = WeightVector::Zero(n);
@@ -232,6 +288,7 @@ SimplexQpResult solveSimplexQp(const MseMatrix& m, BaseMask valid,
       return result;
     }
     result.weights[index[size_t(k)]] = v;
+    if (isFree[size_t(k)]) result.support |= BaseMask(1) << index[size_t(k)];
     total += v;
   }
   if (!(std::abs(total) > 0.0)) {

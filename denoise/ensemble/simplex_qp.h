@@ -36,11 +36,16 @@ struct SimplexQpOptions {
 
 struct SimplexQpResult {
   WeightVector weights;
-  int iterations = 0;  // active-set iterations (equality-constrained solves)
+  int iterations = 0;    // active-set iterations (equality-constrained solves)
+  BaseMask support = 0;  // the free set at the optimum (0 when the solver fell back to uniform)
 };
 
+// `start`: the bases that begin free (a warm start, e.g. the support of a neighbouring pixel's
+// solution; all valid bases when empty). It changes how many iterations are needed, not the
+// optimum: the result is the same up to rounding, and bit for bit whenever the same support is
+// reached (the weights are the solution of the equality problem on that support).
 SimplexQpResult solveSimplexQp(const MseMatrix& m, BaseMask valid = ~BaseMask(0),
-                               const SimplexQpOptions& options = {});
+                               const SimplexQpOptions& options = {}, BaseMask start = ~BaseMask(0));
 
 // wᵀ M w, accumulated in a fixed order.
 double quadraticForm(const MseMatrix& m, const WeightVector& w);

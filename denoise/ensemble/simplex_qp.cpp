@@ -9,7 +9,6 @@ namespace chorus {
 namespace {
 
 constexpr int kMaxKkt = kMaxDenoisers + 1;
-using KktMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxKkt, kMaxKkt + 1>;
 
 // Entries below this fraction of the largest |⟨M⟩| entry are rounding noise.
 constexpr double kNegligibleTangent = 1e-13;
@@ -21,48 +20,67 @@ constexpr double kClearMultiplier = 1e-6;
 
 // The equality-constrained sub-problem on the free set F (other weights fixed at 0):
 //   min ½ w_Fᵀ Q_FF w_F  s.t.  Σ w_F = 1   ⇔   [Q_FF −1; 1ᵀ 0] [w_F; λ] = [0; 1],
-// solved by Gaussian elimination with partial pivoting on the bordered (KKT) matrix.
+// solved by Gaussian elimination with partial pivoting on the bordered (KKT) matrix of size
+// n = |F| + 1 ≤ kN (a stack array; with n == kN the loops have constant bounds and unroll).
 // Returns false when the KKT matrix is numerically singular.
-bool solveEqualityProblem(const MseMatrix& q, const std::array<int, kMaxDenoisers>& free,
-                          int freeCount, WeightVector& target, double& lambda) {
-  const int n = freeCount + 1;
-  KktMatrix a(n, n + 1);
+template <int kN>
+bool solveKkt(const MseMatrix& q, const std::array<int, kMaxDenoisers>& free, int n,
+              WeightVector& target, double& lambda) {
+  const int freeCount = n - 1;
+  std::array<std::array<double, kN + 1>, kN> a;
   for (int r = 0; r < freeCount; ++r) {
-    for (int c = 0; c < freeCount; ++c) a(r, c) = q(free[r], free[c]);
-    a(r, freeCount) = -1.0;
-    a(r, n) = 0.0;
+    for (int c = 0; c < freeCount; ++c) a[r][c] = q(free[size_t(r)], free[size_t(c)]);
+    a[r][freeCount] = -1.0;
+    a[r][n] = 0.0;
   }
-  for (int c = 0; c < freeCount; ++c) a(freeCount, c) = 1.0;
-  a(freeCount, freeCount) = 0.0;
-  a(freeCount, n) = 1.0;
+  for (int c = 0; c < freeCount; ++c) a[freeCount][c] = 1.0;
+  a[freeCount][freeCount] = 0.0;
+  a[freeCount][n] = 1.0;
 
   double largest = 0.0;
   for (int r = 0; r < n; ++r)
-    for (int c = 0; c < n; ++c) largest = std::max(largest, std::abs(a(r, c)));
+    for (int c = 0; c < n; ++c) largest = std::max(largest, std::abs(a[r][c]));
   const double singular = largest * 1e-15;
   for (int k = 0; k < n; ++k) {
     int pivot = k;
     for (int r = k + 1; r < n; ++r)
-      if (std::abs(a(r, k)) > std::abs(a(pivot, k))) pivot = r;
-    if (!(std::abs(a(pivot, k)) > singular)) return false;
+      if (std::abs(a[r][k]) > std::abs(a[pivot][k])) pivot = r;
+    if (!(std::abs(a[pivot][k]) > singular)) return false;
     if (pivot != k)
-      for (int c = k; c <= n; ++c) std::swap(a(k, c), a(pivot, c));
-    const double inverse = 1.0 / a(k, k);
+      for (int c = k; c <= n; ++c) std::swap(a[k][c], a[pivot][c]);
+    const double inverse = 1.0 / a[k][k];
     for (int r = k + 1; r < n; ++r) {
-      const double factor = a(r, k) * inverse;
+      const double factor = a[r][k] * inverse;
       if (factor == 0.0) continue;
-      for (int c = k + 1; c <= n; ++c) a(r, c) -= factor * a(k, c);
+      for (int c = k + 1; c <= n; ++c) a[r][c] -= factor * a[k][c];
     }
   }
-  std::array<double, kMaxKkt> x{};
+  std::array<double, kN> x{};
   for (int r = n - 1; r >= 0; --r) {
-    double sum = a(r, n);
-    for (int c = r + 1; c < n; ++c) sum -= a(r, c) * x[size_t(c)];
-    x[size_t(r)] = sum / a(r, r);
+    double sum = a[r][n];
+    for (int c = r + 1; c < n; ++c) sum -= a[r][c] * x[size_t(c)];
+    x[size_t(r)] = sum / a[r][r];
   }
-  for (int r = 0; r < freeCount; ++r) target[free[r]] = x[size_t(r)];
+  for (int r = 0; r < freeCount; ++r) target[free[size_t(r)]] = x[size_t(r)];
   lambda = x[size_t(freeCount)];
   return std::isfinite(lambda);
+}
+
+bool solveEqualityProblem(const MseMatrix& q, const std::array<int, kMaxDenoisers>& free,
+                          int freeCount, WeightVector& target, double& lambda) {
+  // Sizes of the usual few bases get their own unrolled copy (same arithmetic).
+  switch (freeCount + 1) {
+    case 2:
+      return solveKkt<2>(q, free, 2, target, lambda);
+    case 3:
+      return solveKkt<3>(q, free, 3, target, lambda);
+    case 4:
+      return solveKkt<4>(q, free, 4, target, lambda);
+    case 5:
+      return solveKkt<5>(q, free, 5, target, lambda);
+    default:
+      return solveKkt<kMaxKkt>(q, free, freeCount + 1, target, lambda);
+  }
 }
 
 WeightVector uniformOver(int n, BaseMask mask) {
@@ -193,6 +211,7 @@ double quadraticForm(const MseMatrix& m, const WeightVector& w) {
 BaseMask finiteBases(const MseMatrix& m, BaseMask valid) {
   const int n = int(m.rows());
   BaseMask mask = valid & allBases(n);
+  if (m.allFinite()) return mask;  // the common case, in one pass
   for (int i = 0; i < n; ++i)
     if (!std::isfinite(m(i, i))) mask &= ~(BaseMask(1) << i);
   for (;;) {
@@ -268,7 +287,25 @@ SimplexQpResult solveSimplexQp(const MseMatrix& m, BaseMask valid, const Simplex
   WeightVector w;
   if ((start & mask) != mask && positiveOnTangent(a)) {
     for (int k = 0; k < count; ++k) isFree[size_t(k)] = (start >> index[size_t(k)]) & 1u;
-    w = activeSet(a, options.nonNegative, isFree, result.iterations, smallestMultiplier);
+    int vertex = -1;
+    for (int k = 0; k < count; ++k)
+      if (isFree[size_t(k)]) vertex = vertex < 0 ? k : -2;
+    // One free base v: w = e_v is the optimum if every μ_j = a_jv − a_vv is clearly positive
+    // (an equality solve on {v} gives the same up to rounding, and the weights become exactly
+    // e_v either way); otherwise the active set continues from there.
+    if (vertex >= 0 && options.nonNegative) {
+      smallestMultiplier = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < count; ++k)
+        if (k != vertex)
+          smallestMultiplier = std::min(smallestMultiplier, a(k, vertex) - a(vertex, vertex));
+    }
+    if (vertex >= 0 && options.nonNegative && smallestMultiplier > kClearMultiplier) {
+      w = WeightVector::Zero(count);
+      w[vertex] = 1.0;
+      result.iterations = 1;
+    } else {
+      w = activeSet(a, options.nonNegative, isFree, result.iterations, smallestMultiplier);
+    }
   }
   if (!(smallestMultiplier > kClearMultiplier)) {
     const int warmIterations = result.iterations;

@@ -126,7 +126,8 @@ std::vector<Image> crossBilateralFilter(std::span<const Image> maps, const Color
     in.push_back(inPlanes[j].data());
     out.push_back(outPlanes[j].data());
   }
-  constexpr int kRowsPerTask = 16;
+  // Tall tasks: the filter evaluates the kernel pairs that straddle a task's top edge twice.
+  constexpr int kRowsPerTask = 32;
   tbb::parallel_for(0, (h + kRowsPerTask - 1) / kRowsPerTask, [&](int task) {
     const int y0 = task * kRowsPerTask, y1 = std::min(h, y0 + kRowsPerTask);
     std::vector<float*> rowsOut;

@@ -88,7 +88,7 @@ Timing timed(Work&& work) {
 Timing timeMseEstimate(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,
                        const MseOptions& options) {
   const MseEstimator estimator(guides, bases, options);
-  constexpr int kBandRows = 16;
+  constexpr int kBandRows = 32;
   const int bands = (estimator.height() + kBandRows - 1) / kBandRows;
   return timed([&] {
     tbb::parallel_for(0, bands, [&](int band) {

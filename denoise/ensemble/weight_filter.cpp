@@ -11,17 +11,28 @@
 namespace chorus {
 namespace {
 
+// Calls body(p0, p1) for blocks of pixel indices in parallel (element-wise conversions).
+template <typename Body>
+void forPixelBlocks(size_t pixels, const Body& body) {
+  constexpr size_t kBlock = 16384;
+  tbb::parallel_for(size_t(0), (pixels + kBlock - 1) / kBlock, [&](size_t block) {
+    body(block * kBlock, std::min(pixels, (block + 1) * kBlock));
+  });
+}
+
 // Planar copy of an interleaved image: plane c holds channel c, row-major.
 std::vector<float> toPlanes(const Image& image) {
   const size_t pixels = image.pixelCount();
   const int channels = image.channels();
   std::vector<float> planes(pixels * size_t(channels));
   const float* src = image.data();
-  for (size_t p = 0; p < pixels; ++p)
-    for (int c = 0; c < channels; ++c) {
-      const float v = src[p * size_t(channels) + size_t(c)];
-      planes[size_t(c) * pixels + p] = std::isfinite(v) ? v : 0.0f;
-    }
+  forPixelBlocks(pixels, [&](size_t p0, size_t p1) {
+    for (size_t p = p0; p < p1; ++p)
+      for (int c = 0; c < channels; ++c) {
+        const float v = src[p * size_t(channels) + size_t(c)];
+        planes[size_t(c) * pixels + p] = std::isfinite(v) ? v : 0.0f;
+      }
+  });
   return planes;
 }
 
@@ -73,13 +84,16 @@ ColorGuide makeColorGuide(const Image& blend, const Image& blendA, const Image& 
   ColorGuide guide;
   guide.color = Image(blend.width(), blend.height(), blend.channels());
   Image halfVariance(blend.width(), blend.height(), blend.channels());
-  for (size_t e = 0; e < blend.size(); ++e) {
-    const double z = blend.data()[e] / scale;
-    guide.color.data()[e] = std::isfinite(z) ? float(std::clamp(z, -1e6, 1e6)) : 0.0f;
-    const double d = (double(blendA.data()[e]) - blendB.data()[e]) / scale;
-    const double v = 0.5 * d * d;
-    halfVariance.data()[e] = std::isfinite(v) ? float(std::min(v, 1e12)) : 1e12f;
-  }
+  const int channels = blend.channels();
+  forPixelBlocks(blend.pixelCount(), [&](size_t p0, size_t p1) {
+    for (size_t e = p0 * size_t(channels); e < p1 * size_t(channels); ++e) {
+      const double z = blend.data()[e] / scale;
+      guide.color.data()[e] = std::isfinite(z) ? float(std::clamp(z, -1e6, 1e6)) : 0.0f;
+      const double d = (double(blendA.data()[e]) - blendB.data()[e]) / scale;
+      const double v = 0.5 * d * d;
+      halfVariance.data()[e] = std::isfinite(v) ? float(std::min(v, 1e12)) : 1e12f;
+    }
+  });
   guide.variance =
       gaussianBlur(halfVariance, options.varianceBlurRadius, options.varianceBlurSigma);
   return guide;
@@ -109,23 +123,18 @@ std::vector<Image> crossBilateralFilter(std::span<const Image> maps, const Color
   kernel.kNormal = 0.5f / (options.sigmaNormal * options.sigmaNormal);
   kernel.kAlbedo = 0.5f / (options.sigmaAlbedo * options.sigmaAlbedo);
 
-  std::vector<std::vector<float>> inPlanes, outPlanes;
+  std::vector<std::vector<float>> mapPlanes;
+  std::vector<const float*> in;
   for (const Image& map : maps) {
     if (map.width() != w || map.height() != h)
       throw Error("crossBilateralFilter: maps differ in size");
-    const std::vector<float> planes = toPlanes(map);
-    for (int c = 0; c < map.channels(); ++c) {
-      inPlanes.emplace_back(planes.begin() + std::ptrdiff_t(size_t(c) * pixels),
-                            planes.begin() + std::ptrdiff_t(size_t(c + 1) * pixels));
-      outPlanes.emplace_back(pixels);
-    }
+    mapPlanes.push_back(toPlanes(map));
+    for (int c = 0; c < map.channels(); ++c)
+      in.push_back(mapPlanes.back().data() + size_t(c) * pixels);
   }
-  std::vector<const float*> in;
+  std::vector<float> outPlanes(in.size() * pixels);
   std::vector<float*> out;
-  for (size_t j = 0; j < inPlanes.size(); ++j) {
-    in.push_back(inPlanes[j].data());
-    out.push_back(outPlanes[j].data());
-  }
+  for (size_t j = 0; j < in.size(); ++j) out.push_back(outPlanes.data() + j * pixels);
   // Tall tasks: the filter evaluates the kernel pairs that straddle a task's top edge twice.
   constexpr int kRowsPerTask = 32;
   tbb::parallel_for(0, (h + kRowsPerTask - 1) / kRowsPerTask, [&](int task) {
@@ -140,9 +149,12 @@ std::vector<Image> crossBilateralFilter(std::span<const Image> maps, const Color
   for (const Image& map : maps) {
     const int channels = map.channels();
     Image image(w, h, channels);
-    for (int c = 0; c < channels; ++c, ++j)
-      for (size_t p = 0; p < pixels; ++p)
-        image.data()[p * size_t(channels) + size_t(c)] = outPlanes[j][p];
+    forPixelBlocks(pixels, [&](size_t p0, size_t p1) {
+      for (size_t p = p0; p < p1; ++p)
+        for (int c = 0; c < channels; ++c)
+          image.data()[p * size_t(channels) + size_t(c)] = out[j + size_t(c)][p];
+    });
+    j += size_t(channels);
     result.push_back(std::move(image));
   }
   return result;

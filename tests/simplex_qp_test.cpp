@@ -220,6 +220,30 @@ TEST(SimplexQp, MatchesDenseGridForTwoAndThreeBases) {
   EXPECT_GE(instances, 3000);
 }
 
+// Estimates of two nearly identical outputs left slightly indefinite on the tangent space
+// (here −1e-5 of its scale along e_0 − e_1, as float rounding does): the solver ends well
+// before its iteration cap on weights within the convexifying ridge (≤ 1e-3·s) of the grid
+// optimum.
+TEST(SimplexQp, SlightlyIndefiniteEstimatesConverge) {
+  std::mt19937_64 rng(13);
+  for (int n : {3, 5})
+    for (int k = 0; k < 200; ++k) {
+      MseMatrix m = randomInstance(n, Shape::Duplicated, rng);
+      const double scale = std::max(tangentScale(m), 1e-300);
+      WeightVector v = WeightVector::Zero(n);
+      v[0] = 1.0, v[1] = -1.0;
+      m -= 1e-5 * scale * v * v.transpose();
+      const SimplexQpResult result = solveSimplexQp(m);
+      expectOnSimplex(result.weights, n);
+      ASSERT_LT(result.iterations, 8 * (n + 2)) << "n " << n << " instance " << k;
+      if (n == 3) {
+        ASSERT_LE(objective(m, result.weights), gridMinimum(m, 300) + 1e-3 * scale)
+            << "instance " << k << "\n"
+            << m;
+      }
+    }
+}
+
 TEST(SimplexQp, MatchesProjectedGradientAndKktUpToEightBases) {
   std::mt19937_64 rng(12);
   int instances = 0;

@@ -17,6 +17,8 @@ constexpr double kMultiplierTolerance = 1e-11;
 // A warm-started solution is kept when every bound weight's multiplier exceeds this: far above
 // both the tolerance and what the ridge (ρ = 1e-8 by default) can decide.
 constexpr double kClearMultiplier = 1e-6;
+// The largest ridge (relative to the mean tangent eigenvalue) that restores convexity.
+constexpr double kLargestRidge = 1e-3;
 
 // The equality-constrained sub-problem on the free set F (other weights fixed at 0):
 //   min ½ w_Fᵀ Q_FF w_F  s.t.  Σ w_F = 1   ⇔   [Q_FF −1; 1ᵀ 0] [w_F; λ] = [0; 1],
@@ -275,6 +277,16 @@ SimplexQpResult solveSimplexQp(const MseMatrix& m, BaseMask valid, const Simplex
   }
   a /= scale;
   a.diagonal().array() += options.relativeRidge;
+  // Float-stored estimates of nearly identical outputs can be slightly indefinite on the
+  // tangent space, where the active set may cycle to its iteration cap without reaching an
+  // optimum. Raising the ridge tenfold at a time (up to 1e-3 of the mean eigenvalue) until the
+  // problem is convex again restores the exact method; the weights move by about as much as the
+  // indefiniteness that rounding put there.
+  bool convex = positiveOnTangent(a);
+  for (double ridge = options.relativeRidge; !convex && ridge < kLargestRidge; ridge *= 10.0) {
+    a.diagonal().array() += 9.0 * ridge;
+    convex = positiveOnTangent(a);
+  }
 
   // A warm start must not change the result, so it is taken only where the minimiser is unique
   // (float-stored estimates of nearly identical outputs can be slightly indefinite on the
@@ -285,7 +297,7 @@ SimplexQpResult solveSimplexQp(const MseMatrix& m, BaseMask valid, const Simplex
   std::array<bool, kMaxDenoisers> isFree{};
   double smallestMultiplier = 0.0;
   WeightVector w;
-  if ((start & mask) != mask && positiveOnTangent(a)) {
+  if ((start & mask) != mask && convex) {
     for (int k = 0; k < count; ++k) isFree[size_t(k)] = (start >> index[size_t(k)]) & 1u;
     int vertex = -1;
     for (int k = 0; k < count; ++k)

@@ -110,7 +110,7 @@ CHORUS_SIMD_CLONES_EXACT void kernelRow(const PlanarGuides& g, const BilateralKe
 //   acc:    plane 0 the weight sum Σk, plane 1 + j the weighted sum of plane j; rows y0 … y1 − 1
 //           of `width` floats from column x0.
 struct Tile {
-  int rows, width, stride, r;
+  int width, stride, r;
   const float* source;
   size_t sourcePlane;
   const float* kernel;
@@ -225,7 +225,6 @@ void filterPlaneRows(const PlanarGuides& guides, const BilateralKernel& kernel,
   std::vector<float> k(size_t(2 * r + 1) * size_t(r + 1) * size_t(stride));
   std::vector<float> acc(size_t(planes + 1) * size_t(rows) * size_t(kBlock));
   Tile tile;
-  tile.rows = rows;
   tile.stride = stride;
   tile.r = r;
   tile.source = source.data();
@@ -283,7 +282,7 @@ void filterPlaneRows(const PlanarGuides& guides, const BilateralKernel& kernel,
           std::fill(at(valid1), at(need1), 0.0f);
         }
         if (sy < y0) continue;
-        const RowTerms terms{sy - y0, dy, dxLo, slot, (sy - dy - (y0 - dy)) % (dy + 1)};
+        const RowTerms terms{sy - y0, dy, dxLo, slot, (sy - y0) % (dy + 1)};
         accumulateRow(tile, planes, terms);
       }
     }

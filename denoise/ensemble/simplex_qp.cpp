@@ -279,21 +279,20 @@ SimplexQpResult solveSimplexQp(const MseMatrix& m, BaseMask valid, const Simplex
   a.diagonal().array() += options.relativeRidge;
   // Float-stored estimates of nearly identical outputs can be slightly indefinite on the
   // tangent space, where the active set may cycle to its iteration cap without reaching an
-  // optimum. Raising the ridge tenfold at a time (up to 1e-3 of the mean eigenvalue) until the
-  // problem is convex again restores the exact method; the weights move by about as much as the
-  // indefiniteness that rounding put there.
+  // optimum. Raising the ridge tenfold at a time (ρ, 10ρ, 100ρ, … up to 1e-3 of the mean
+  // eigenvalue) until the problem is convex again restores the exact method; the weights move
+  // by about as much as the indefiniteness that rounding put there.
   bool convex = positiveOnTangent(a);
   for (double ridge = options.relativeRidge; !convex && ridge < kLargestRidge; ridge *= 10.0) {
-    a.diagonal().array() += 9.0 * ridge;
+    a.diagonal().array() += 9.0 * ridge;  // the diagonal's ridge becomes 10 × ridge
     convex = positiveOnTangent(a);
   }
 
   // A warm start must not change the result, so it is taken only where the minimiser is unique
-  // (float-stored estimates of nearly identical outputs can be slightly indefinite on the
-  // tangent space; there the active set may end, or cycle, elsewhere), and kept only if every
-  // bound weight's multiplier is clearly positive: a multiplier within the solver's tolerance
-  // (as for a duplicated base, whose share the ridge decides by only ρ·w) could have gone
-  // either way, and the cold start is what decides it.
+  // (the problem is convex, see above), and kept only if every bound weight's multiplier is
+  // clearly positive: a multiplier within the solver's tolerance (as for a duplicated base,
+  // whose share the ridge decides by only ρ·w) could have gone either way, and the cold start
+  // is what decides it.
   std::array<bool, kMaxDenoisers> isFree{};
   double smallestMultiplier = 0.0;
   WeightVector w;

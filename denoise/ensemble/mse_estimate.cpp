@@ -134,9 +134,9 @@ BaseMask MseEstimator::validAt(size_t pixel) const {
 }
 
 BaseMask MseEstimator::solvableAt(size_t pixel) const {
-  BaseMask mask = validAt(pixel);
-  const size_t e = pixel * 3;
+  const BaseMask mask = validAt(pixel);
   if (!(options_.consistency > 0) || reference_) return mask;
+  const size_t e = pixel * 3;
   BaseMask consistent = 0;
   for (int i = 0; i < baseCount_; ++i) {
     if (!((mask >> i) & 1u)) continue;

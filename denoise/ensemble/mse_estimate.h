@@ -31,7 +31,7 @@
 //   (Σ_i H_ii over the groups) in units of (mean |x|)² (relative form: relative units). A
 //   typical pixel keeps about its weight; a firefly's terms, whose noise (the cross terms
 //   −x^A y_i^B with a huge x^A) would otherwise choose the weights of every pixel within the
-//   radius, count about as much as F. 0 = off. Measured: README, "Ensemble options".
+//   radius, count about as much as F. 0 = off. Measured: README, "Ensemble", Outlier cap.
 // - consistency k: at a pixel, a base whose full-buffer output lies further than
 //   k·|y^A − y^B|/2 + 0.1·(mean |x| + |ȳ|) from the mean ȳ of its half-buffer outputs in some
 //   channel gets weight 0 (unless every base does). The estimate judges the half-buffer runs;

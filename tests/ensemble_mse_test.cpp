@@ -111,6 +111,14 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
       for (float v : image->values()) sum += std::abs(v);
     unit = std::pow(sum / double(2 * f.truth.size()), 2);
   }
+  // The relative form's 1 / (μ̂² + ε), μ̂ the mean of the full-buffer outputs; 1 otherwise.
+  const auto channelWeight = [&](int qx, int qy, int c) {
+    if (!o.relative) return 1.0;
+    double mu = 0;
+    for (const BaseOutputs& b : f.bases) mu += b.full(qx, qy, c);
+    mu /= n;
+    return 1.0 / (mu * mu + kRelMseEpsilon);
+  };
   double kernelSum = 0;
   for (int qy = std::max(0, y - o.windowRadius); qy <= std::min(h - 1, y + o.windowRadius); ++qy)
     for (int qx = std::max(0, x - o.windowRadius); qx <= std::min(w - 1, x + o.windowRadius);
@@ -121,13 +129,7 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
         double trace = 0;  // Σ_c Σ_i ½((y_i^A − x^B)² + (y_i^B − x^A)²), weighted as below
         for (int c = 0; c < 3; ++c) {
           const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
-          double weight = 1.0;
-          if (o.relative) {
-            double mu = 0;
-            for (const BaseOutputs& b : f.bases) mu += b.full(qx, qy, c);
-            mu /= n;
-            weight /= mu * mu + kRelMseEpsilon;
-          }
+          const double weight = channelWeight(qx, qy, c);
           for (const BaseOutputs& b : f.bases)
             trace += weight * 0.5 *
                      (std::pow(b.a(qx, qy, c) - xB, 2) + std::pow(b.b(qx, qy, c) - xA, 2));
@@ -137,13 +139,7 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
       for (int c = 0; c < 3; ++c) {
         const int g = groups == 3 ? c : 0;
         const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
-        double weight = k;
-        if (o.relative) {
-          double mu = 0;
-          for (const BaseOutputs& b : f.bases) mu += b.full(qx, qy, c);
-          mu /= n;
-          weight /= mu * mu + kRelMseEpsilon;
-        }
+        const double weight = k * channelWeight(qx, qy, c);
         for (int i = 0; i < n; ++i)
           for (int j = 0; j < n; ++j) {
             const double yAi = f.bases[size_t(i)].a(qx, qy, c),
@@ -339,7 +335,7 @@ TEST(MseEstimate, NonFiniteOutputsAreExcluded) {
 TEST(MseEstimate, InconsistentFullRunIsLeftOutOfTheSolve) {
   Fixture f = makeFixture(12, 10, 5);
   for (int c = 0; c < 3; ++c) f.bases[1].full(4, 4, c) += 20.0f;  // halves: box blurs, ~1
-  f.bases[2].full(8, 6, 0) += 0.05f;                               // within the allowance
+  f.bases[2].full(8, 6, 0) += 0.05f;                              // within the allowance
   MseOptions on, off;
   on.windowRadius = off.windowRadius = 2;
   off.consistency = 0;

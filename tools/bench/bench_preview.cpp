@@ -1,11 +1,10 @@
 // Preview latency (not a test; prints figures): what `chorus render --preview` does after the
 // scene is loaded — render at 4 spp with K = 4, run the preview members on half A, half B and
-// the full buffer, solve and blend (previews skip the weight filter), encode the PNG — timed end to
-// end (best and median of
-// --repeat runs, wall clock and process CPU time), on scenes/cornell-box.gltf at 512×512 by
-// default. The target is ≤ 1.0 s wall on 2 cores. Then the relMSE it reaches against a
-// high-spp reference (cached with --reference-cache), next to the noisy input and the full
-// default ensemble (`chorus render`'s default members) at the same spp.
+// the full buffer, solve and blend (previews skip the weight filter), encode the PNG — timed
+// end to end (best and median of --repeat runs, wall clock and process CPU time), on
+// scenes/cornell-box.gltf at 512×512 by default. The target is ≤ 1.0 s wall on 2 cores. Then the
+// relMSE it reaches against a high-spp reference (cached with --reference-cache), next to the noisy
+// input and the full default ensemble (`chorus render`'s default members) at the same spp.
 #include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <CLI/CLI.hpp>

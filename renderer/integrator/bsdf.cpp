@@ -81,6 +81,7 @@ Bsdf::Bsdf(const MaterialPoint& material) : m_(material) {
   // specular = 0 removes the layer (and with metallic = 0 leaves a plain Lambertian, which then
   // skips all microfacet work).
   roughReflection_ = !smooth_ && (m_.metallic > 0 || m_.specular > 0);
+  lambertian_ = m_.metallic == 0 && m_.specular == 0 && m_.transmission == 0;
 
   // KHR_materials_specular: f0 = min(f0(ior) · specularColor, 1) · specular, f90 = specular.
   const float f0Ior = f0FromIor(eta_);
@@ -130,6 +131,11 @@ Bsdf::Context Bsdf::context(Vec3f wo) const {
   c.flip = wo.z < 0;
   c.inside = c.flip && solidTransmission_;
   c.wo = c.flip ? mirrorZ(wo) : wo;
+  if (lambertian_) {
+    // What the general path below reduces to, without its Fresnel and layer-albedo terms.
+    if (m_.baseColor.average() > 0) c.weights.diffuse = 1.0f;
+    return c;
+  }
   if (!c.inside) c.layerAlbedoO = layerAlbedo(c.wo.z);
   if (roughReflection_ || (!smooth_ && transmits_)) c.lambdaO = ggx_.lambda(c.wo);
   c.weights = lobeWeights(c);

@@ -102,6 +102,7 @@ class Bsdf {
   SpecularAlbedoRow layerAlbedoRow_;  // rough with a specular layer only
   bool smooth_ = false;
   bool roughReflection_ = false;    // a rough metal or specular-layer lobe exists
+  bool lambertian_ = false;         // only the diffuse lobe, with nothing layered on it
   bool transmits_ = false;          // hasTransmission()
   bool solidTransmission_ = false;  // refracts into a closed volume (wo.z < 0 is inside)
   float eta_ = 1.5f;                // IOR used by the interface (clamped away from 1)

@@ -1,6 +1,7 @@
 #include "renderer/integrator/path_tracer.h"
 
 #include <cmath>
+#include <optional>
 
 #include "renderer/integrator/bsdf.h"
 #include "renderer/integrator/ray_offset.h"
@@ -62,12 +63,10 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& r
   int volumeMaterial = -1;  // the material whose interior the path is in, or −1
 
   for (int depth = 0;; ++depth) {
-    // Sampler dimensions per bounce, in the documented order.
-    const float uLobe = sampler.get1D();
-    const Vec2f uDirection = sampler.get2D();
-    const float uLight = sampler.get1D();
-    const Vec2f uLightPoint = sampler.get2D();
-    const float uRoulette = sampler.get1D();
+    // Sampler dimensions per bounce, in the documented order (sampler.h), drawn only when used.
+    const uint32_t bounceDimensions = sampler.reserve(7);
+    const uint32_t dLobe = bounceDimensions, dDirection = dLobe + 1, dLight = dDirection + 2,
+                   dLightPoint = dLight + 1, dRoulette = dLightPoint + 2;
 
     Hit hit;
     ++rays;
@@ -103,7 +102,9 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& r
       L += beta * Le * w;
     }
 
-    const Bsdf bsdf(scene_.materialPoint(si));
+    std::optional<Bsdf> texturedBsdf;
+    const Bsdf& bsdf = material.uniformBsdf ? *material.uniformBsdf
+                                            : texturedBsdf.emplace(scene_.materialPoint(si));
     const bool transmissive = bsdf.hasTransmission();
     const bool specular = bsdf.isPurelySpecular();
     const Vec3f wo = -normalize(ray.direction);
@@ -130,7 +131,8 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& r
     // Next-event estimation.
     bool lightVisible = false;
     if (!specular && !lights_.empty()) {
-      if (const auto ls = lights_.sample(si.position, uLight, uLightPoint)) {
+      if (const auto ls =
+              lights_.sample(si.position, sampler.get1DAt(dLight), sampler.get2DAt(dLightPoint))) {
         const Vec3f wiLocal = frame.toLocal(ls->wi);
         const bool sameSide = (dot(ls->wi, ng) > 0) == (dot(wo, ng) > 0);
         if (transmissive || sameSide) {
@@ -153,7 +155,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& r
     }
 
     // Continue the path by sampling the BSDF.
-    const auto bs = bsdf.sample(woLocal, uLobe, uDirection);
+    const auto bs = bsdf.sample(woLocal, sampler.get1DAt(dLobe), sampler.get2DAt(dDirection));
     if (!bs || !(bs->pdf > 0) || bs->f.isBlack()) break;
     const Vec3f wi = frame.fromLocal(bs->wi);
     // Reject directions whose side of the geometric surface contradicts the lobe (possible
@@ -176,7 +178,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& r
 
     if (depth + 1 >= settings_.rouletteStartDepth) {
       const float survive = std::min(1.0f, (beta * etaScale).maxComponent());
-      if (!(uRoulette < survive)) break;
+      if (!(sampler.get1DAt(dRoulette) < survive)) break;
       beta = beta / survive;
     }
   }

@@ -41,7 +41,6 @@ inline uint32_t lowerBitsPermutation(uint32_t x, uint32_t seed) {
   return x;
 }
 
-
 // Generator matrix columns of the second Sobol dimension (primitive polynomial x + 1):
 // v_0 = 1/2, v_k = v_{k-1} xor (v_{k-1} / 2). The first dimension is the van der Corput
 // sequence (the identity matrix), and together they form a (0,2)-sequence in base 2.
@@ -78,8 +77,7 @@ constexpr SobolByteTable makeReversedSobolByteTable() {
   SobolByteTable table{};
   for (int b = 0; b < 4; ++b)
     for (uint32_t x = 0; x < 256; ++x)
-      table[size_t(b)][x] =
-          reverseBits(kSobolDimension1[size_t(3 - b)][reverseBits(x) >> 24]);
+      table[size_t(b)][x] = reverseBits(kSobolDimension1[size_t(3 - b)][reverseBits(x) >> 24]);
   return table;
 }
 constexpr SobolByteTable kReversedSobolDimension1 = makeReversedSobolByteTable();
@@ -108,8 +106,13 @@ void Sampler::startPixelSample(int px, int py, uint32_t indexInSubBuffer, int su
 // index shuffle and independent scrambles (Burley 2020, §4 "padding"), so the points of one
 // call are stratified within the pixel while different calls are mutually independent.
 Vec2f Sampler::get2D() {
-  const uint64_t h = hashCombine(pixelHash_, dimension_);
+  const Vec2f u = get2DAt(dimension_);
   dimension_ += 2;
+  return u;
+}
+
+Vec2f Sampler::get2DAt(uint32_t dimension) const {
+  const uint64_t h = hashCombine(pixelHash_, dimension);
   const uint64_t h2 = mix64(h);
   // shuffled index i = reverseBits(z); dimension 0 of i is reverseBits(i) = z, whose scramble
   // is reverseBits(lowerBitsPermutation(reverseBits(z), ·)); dimension 1 likewise.
@@ -119,9 +122,8 @@ Vec2f Sampler::get2D() {
   return {toUnitFloat(x), toUnitFloat(y)};
 }
 
-float Sampler::get1D() {
-  const uint64_t h = hashCombine(pixelHash_, dimension_);
-  dimension_ += 1;
+float Sampler::get1DAt(uint32_t dimension) const {
+  const uint64_t h = hashCombine(pixelHash_, dimension);
   const uint32_t z = lowerBitsPermutation(reversedIndex_, uint32_t(h));
   return toUnitFloat(reverseBits(lowerBitsPermutation(reverseBits(z), uint32_t(h >> 32))));
 }

@@ -22,13 +22,25 @@ class Sampler {
   // (pixel sample i goes to sub-buffer i mod K with index i / K).
   void startPixelSample(int px, int py, uint32_t indexInSubBuffer, int subBuffer);
 
-  float get1D();
+  float get1D() { return get1DAt(dimension_++); }
   Vec2f get2D();
   Vec2f getPixel2D();  // position inside the pixel, [0,1)²
 
+  // Reserves the next `count` dimensions and returns the first, for draws taken later with
+  // get1DAt / get2DAt, or never: a path skips the draws it does not need (a bounce that escapes,
+  // roulette before it starts) without shifting the dimensions of those it does. A get2D takes
+  // two dimensions, so reserve(3) then get1DAt(d), get2DAt(d + 1) equals get1D(), get2D().
+  uint32_t reserve(uint32_t count) {
+    const uint32_t first = dimension_;
+    dimension_ += count;
+    return first;
+  }
+  float get1DAt(uint32_t dimension) const;
+  Vec2f get2DAt(uint32_t dimension) const;
+
  private:
   uint64_t seed_;
-  uint64_t pixelHash_ = 0;  // hash of (seed, pixel, sub-buffer)
+  uint64_t pixelHash_ = 0;      // hash of (seed, pixel, sub-buffer)
   uint32_t reversedIndex_ = 0;  // the sample's index in its sub-buffer, bits reversed
   uint32_t dimension_ = 0;
 };

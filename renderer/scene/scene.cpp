@@ -98,17 +98,23 @@ bool materialNeedsAlphaTest(const MaterialDesc& m, const std::vector<TextureDesc
   return !(textureOpaque && m.alpha >= threshold);
 }
 
+Vec3f faceNormal(const MeshDesc& mesh, uint32_t primID) {
+  const uint32_t* idx = &mesh.indices[3 * size_t(primID)];
+  const Vec3f& p0 = mesh.positions[idx[0]];
+  const Vec3f ng = cross(mesh.positions[idx[1]] - p0, mesh.positions[idx[2]] - p0);
+  const float ngLength = length(ng);
+  return ngLength > 0 ? ng / ngLength : Vec3f{0, 0, 1};
+}
+
 // The unit geometric normal of a triangle, turned to the side its vertex normals face (the
 // authored normals define the outside; the winding may disagree). *shadingNormal receives the
 // interpolated vertex normal (the geometric normal without usable vertex normals). Positions are
 // read here rather than passed as Vec3f arguments: 12-byte structs passed by value cost
 // store-forwarding stalls on x86-64.
-inline Vec3f orientedGeometricNormal(const MeshDesc& mesh, const uint32_t* idx, float b0, float b1,
-                                     float b2, Vec3f* shadingNormal) {
-  const Vec3f& p0 = mesh.positions[idx[0]];
-  Vec3f ng = cross(mesh.positions[idx[1]] - p0, mesh.positions[idx[2]] - p0);
-  const float ngLength = length(ng);
-  ng = ngLength > 0 ? ng / ngLength : Vec3f{0, 0, 1};
+inline Vec3f orientedGeometricNormal(const SceneMesh& sm, uint32_t primID, const uint32_t* idx,
+                                     float b0, float b1, float b2, Vec3f* shadingNormal) {
+  const MeshDesc& mesh = sm.mesh;
+  Vec3f ng = sm.faceNormals[primID];
   *shadingNormal = ng;
   if (!mesh.normals.empty()) {
     const Vec3f n =
@@ -137,8 +143,11 @@ Scene buildScene(SceneDesc desc, EnvironmentDesc environment) {
   data.textures.reserve(desc.textures.size());
   for (const TextureDesc& t : desc.textures)
     data.textures.emplace_back(data.images[size_t(t.image)], t);
-  for (const MaterialDesc& m : desc.materials)
-    data.materials.push_back({m, materialNeedsAlphaTest(m, desc.textures, data.images)});
+  for (const MaterialDesc& m : desc.materials) {
+    data.materials.push_back({m, materialNeedsAlphaTest(m, desc.textures, data.images), {}});
+    if (!m.hasBsdfTextures())
+      data.materials.back().uniformBsdf.emplace(evaluateMaterial(m, data.textures, Vec2f{0, 0}));
+  }
   data.punctualLights = std::move(desc.lights);
   data.cameras = std::move(desc.cameras);
   data.bounds = desc.bounds;
@@ -146,6 +155,9 @@ Scene buildScene(SceneDesc desc, EnvironmentDesc environment) {
   for (MeshDesc& m : desc.meshes) {
     SceneMesh sm;
     sm.mesh = std::move(m);
+    sm.faceNormals.resize(sm.mesh.triangleCount());
+    for (uint32_t primID = 0; primID < sm.faceNormals.size(); ++primID)
+      sm.faceNormals[primID] = faceNormal(sm.mesh, primID);
     const Material& material = data.materials[size_t(sm.mesh.material)];
     sm.alphaTested = material.alphaTested;
     if (material.desc.isEmissive()) {
@@ -269,7 +281,7 @@ SurfaceInteraction Scene::interaction(const Hit& hit, const Vec3f& rayDirection)
   si.uv = mesh.uvs.empty() ? Vec2f{0, 0}
                            : mesh.uvs[idx[0]] * b0 + mesh.uvs[idx[1]] * b1 + mesh.uvs[idx[2]] * b2;
   Vec3f ns;
-  const Vec3f ng = orientedGeometricNormal(mesh, idx, b0, b1, b2, &ns);
+  const Vec3f ng = orientedGeometricNormal(sm, hit.primID, idx, b0, b1, b2, &ns);
 
   const MaterialDesc& material = data_->materials[size_t(mesh.material)].desc;
   Vec3f tangent;
@@ -309,7 +321,8 @@ MaterialPoint Scene::materialPoint(const SurfaceInteraction& si) const {
 
 Scene::EmitterPoint Scene::emitterPoint(uint32_t geomID, uint32_t primID, float b1, float b2,
                                         const Vec3f& direction) const {
-  const MeshDesc& mesh = data_->meshes[geomID].mesh;
+  const SceneMesh& sm = data_->meshes[geomID];
+  const MeshDesc& mesh = sm.mesh;
   const uint32_t* idx = &mesh.indices[3 * size_t(primID)];
   const float b0 = 1 - b1 - b2;
   const Vec3f p0 = mesh.positions[idx[0]], p1 = mesh.positions[idx[1]], p2 = mesh.positions[idx[2]];
@@ -317,7 +330,7 @@ Scene::EmitterPoint Scene::emitterPoint(uint32_t geomID, uint32_t primID, float 
   e.position = p0 * b0 + p1 * b1 + p2 * b2;
   e.positionError = barycentricPositionError(p0, p1, p2, b0, b1, b2);
   Vec3f ns;
-  e.geometricNormal = orientedGeometricNormal(mesh, idx, b0, b1, b2, &ns);
+  e.geometricNormal = orientedGeometricNormal(sm, primID, idx, b0, b1, b2, &ns);
   const MaterialDesc& m = data_->materials[size_t(mesh.material)].desc;
   const bool front = dot(direction, e.geometricNormal) < 0;
   if (m.isEmissive() && (front || m.doubleSided)) {

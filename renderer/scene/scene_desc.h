@@ -90,6 +90,11 @@ struct MaterialDesc {
 
   bool isEmissive() const { return emissive.maxComponent() > 0; }
   bool isTransmissive() const { return transmission > 0; }
+  // Whether any texture feeds the BSDF (the normal and emissive maps do not).
+  bool hasBsdfTextures() const {
+    return baseColorTexture >= 0 || metallicRoughnessTexture >= 0 || transmissionTexture >= 0 ||
+           specularTexture >= 0 || specularColorTexture >= 0;
+  }
   bool usesTextures() const {
     return baseColorTexture >= 0 || metallicRoughnessTexture >= 0 || normalTexture >= 0 ||
            emissiveTexture >= 0 || transmissionTexture >= 0 || specularTexture >= 0 ||

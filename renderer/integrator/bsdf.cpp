@@ -94,9 +94,16 @@ Bsdf::Bsdf(const MaterialPoint& material) : m_(material) {
     average = layerAlbedoRow_.average();
   }
   averageLayerAlbedo_ = m_.specular * average.albedo(f0Max_, 1.0f);
-  averageLayerAlbedoRgb_ =
+  const Rgb averageLayerAlbedoRgb =
       Rgb(average.albedo(f0_.r, 1.0f), average.albedo(f0_.g, 1.0f), average.albedo(f0_.b, 1.0f)) *
       m_.specular;
+
+  const Rgb dielectricAlbedo = averageLayerAlbedoRgb + m_.baseColor * (1.0f - averageLayerAlbedo_);
+  albedo_ = dielectricAlbedo * (1.0f - m_.metallic) + m_.baseColor * m_.metallic;
+  const bool diffuse =
+      (1.0f - m_.metallic) * (1.0f - m_.transmission) * m_.baseColor.maxComponent() > 0 &&
+      1.0f - averageLayerAlbedo_ > kMinBaseEnergy;
+  purelySpecular_ = smooth_ && !diffuse;
 }
 
 // Fresnel reflectance of the dielectric layer: Schlick at the cosine on the outer side, so
@@ -327,22 +334,6 @@ std::optional<BsdfSample> Bsdf::sample(Vec3f woAsGiven, float uLobe, Vec2f u) co
   const float transmittance = dielectric * m_.transmission * (1.0f - fresnel.maxComponent());
   const float radianceScale = solidTransmission_ ? 1.0f / (eta * eta) : 1.0f;
   return finish({m_.baseColor * (transmittance * radianceScale / -wi.z), wi, lobePdf, true, false});
-}
-
-bool Bsdf::isPurelySpecular() const {
-  const bool diffuse =
-      (1.0f - m_.metallic) * (1.0f - m_.transmission) * m_.baseColor.maxComponent() > 0 &&
-      1.0f - averageLayerAlbedo_ > kMinBaseEnergy;
-  return smooth_ && !diffuse;
-}
-
-bool Bsdf::hasTransmission() const {
-  return transmits_;
-}
-
-Rgb Bsdf::albedo() const {
-  const Rgb dielectric = averageLayerAlbedoRgb_ + m_.baseColor * (1.0f - averageLayerAlbedo_);
-  return dielectric * (1.0f - m_.metallic) + m_.baseColor * m_.metallic;
 }
 
 }  // namespace chorus::render

@@ -78,13 +78,13 @@ class Bsdf {
 
   // Every lobe is a delta (smooth glass, smooth metal): features are taken further down the
   // path, at the first vertex where this is false.
-  bool isPurelySpecular() const;
+  bool isPurelySpecular() const { return purelySpecular_; }
   // Transmits light at all (so the integrator keeps transmission paths and shadow rays
   // pass thin-walled surfaces only where this is true).
-  bool hasTransmission() const;
+  bool hasTransmission() const { return transmits_; }
   // The value recorded in the albedo feature buffer: the material's overall reflectance colour
   // (baseColor for diffuse and metals, weighted by the lobe mix).
-  Rgb albedo() const;
+  Rgb albedo() const { return albedo_; }
 
  private:
   struct LobeWeights;
@@ -103,13 +103,14 @@ class Bsdf {
   bool smooth_ = false;
   bool roughReflection_ = false;    // a rough metal or specular-layer lobe exists
   bool lambertian_ = false;         // only the diffuse lobe, with nothing layered on it
+  bool purelySpecular_ = false;     // isPurelySpecular()
   bool transmits_ = false;          // hasTransmission()
   bool solidTransmission_ = false;  // refracts into a closed volume (wo.z < 0 is inside)
   float eta_ = 1.5f;                // IOR used by the interface (clamped away from 1)
   Rgb f0_;                          // dielectric normal reflectance per channel, before specular
   float f0Max_ = 0;
   float averageLayerAlbedo_ = 0;  // E_avg, max over channels
-  Rgb averageLayerAlbedoRgb_;     // E_avg per channel, for albedo()
+  Rgb albedo_;                    // albedo()
 };
 
 }  // namespace chorus::render

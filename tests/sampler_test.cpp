@@ -94,6 +94,42 @@ TEST(Sampler, DeterministicAndSeedDependent) {
 
 // The first sample of every pixel, over many pixels, is uniform on [0,1)² (χ² on a 16×16 grid)
 // for the pixel dimensions and for a later pair: scrambles are random per pixel.
+// A draw depends only on (seed, pixel, sub-buffer, sample index, dimension): not on which
+// pixels, sub-buffers or dimensions were drawn before, nor on whether a dimension was skipped
+// (reserve) or first drawn as 1D, and not on how far past the cached dimensions it lies.
+TEST(Sampler, DrawsDoNotDependOnHistory) {
+  const auto fresh1D = [](int px, int py, uint32_t index, int k, uint32_t dimension) {
+    Sampler s(7);
+    s.startPixelSample(px, py, index, k);
+    return s.get1DAt(dimension);
+  };
+  const auto fresh2D = [](int px, int py, uint32_t index, int k, uint32_t dimension) {
+    Sampler s(7);
+    s.startPixelSample(px, py, index, k);
+    return s.get2DAt(dimension);
+  };
+  Sampler shared(7);
+  for (int round = 0; round < 3; ++round) {
+    for (int pixel = 0; pixel < 3; ++pixel) {
+      for (uint32_t i = 0; i < 4; ++i) {
+        for (int k = 3; k >= 0; --k) {
+          const int px = 5 + pixel % 2, py = 9;  // pixels alternate: 5, 6, 5
+          shared.startPixelSample(px, py, i, k);
+          for (uint32_t d : {uint32_t(round), 63u - uint32_t(round), 70u + uint32_t(round)}) {
+            EXPECT_EQ(shared.get1DAt(d), fresh1D(px, py, i, k, d));
+            const Vec2f a = shared.get2DAt(d), b = fresh2D(px, py, i, k, d);
+            EXPECT_EQ(a.x, b.x);
+            EXPECT_EQ(a.y, b.y);
+          }
+          const uint32_t d = shared.reserve(5);
+          EXPECT_EQ(d, 0u);
+          EXPECT_EQ(shared.get1D(), fresh1D(px, py, i, k, 5));
+        }
+      }
+    }
+  }
+}
+
 TEST(Sampler, FirstSamplesAreUniformAcrossPixels) {
   Sampler sampler(5);
   const int grid = 16, pixels = 256 * 64;

@@ -95,11 +95,40 @@ inline float toUnitFloat(uint32_t x) {
 }  // namespace
 
 void Sampler::startPixelSample(int px, int py, uint32_t indexInSubBuffer, int subBuffer) {
-  uint64_t h = hashCombine(mix64(seed_), uint64_t(uint32_t(px)));
-  h = hashCombine(h, uint64_t(uint32_t(py)));
-  pixelHash_ = hashCombine(h, uint64_t(uint32_t(subBuffer)));
+  if (px != pixelX_ || py != pixelY_) {
+    pixelX_ = px;
+    pixelY_ = py;
+    for (SubBufferSeeds& s : seeds_) s.hasPixelHash = false, s.hasDimension = s.hasSecond = 0;
+  }
+  current_ = &seeds_[subBuffer & 3];
+  if (!current_->hasPixelHash) {
+    uint64_t h = hashCombine(mix64(seed_), uint64_t(uint32_t(px)));
+    h = hashCombine(h, uint64_t(uint32_t(py)));
+    current_->pixelHash = hashCombine(h, uint64_t(uint32_t(subBuffer)));
+    current_->hasPixelHash = true;
+  }
   reversedIndex_ = reverseBits(indexInSubBuffer);
   dimension_ = 0;
+}
+
+uint64_t Sampler::dimensionHash(uint32_t dimension) {
+  if (dimension >= kCachedDimensions) return hashCombine(current_->pixelHash, dimension);
+  const uint64_t bit = uint64_t(1) << dimension;
+  if (!(current_->hasDimension & bit)) {
+    current_->dimension[dimension] = hashCombine(current_->pixelHash, dimension);
+    current_->hasDimension |= bit;
+  }
+  return current_->dimension[dimension];
+}
+
+uint64_t Sampler::secondHash(uint32_t dimension) {
+  if (dimension >= kCachedDimensions) return mix64(dimensionHash(dimension));
+  const uint64_t bit = uint64_t(1) << dimension;
+  if (!(current_->hasSecond & bit)) {
+    current_->second[dimension] = mix64(dimensionHash(dimension));
+    current_->hasSecond |= bit;
+  }
+  return current_->second[dimension];
 }
 
 // Every call draws from its own (0,2)-sequence: the pair of dimensions gets an independent
@@ -111,9 +140,9 @@ Vec2f Sampler::get2D() {
   return u;
 }
 
-Vec2f Sampler::get2DAt(uint32_t dimension) const {
-  const uint64_t h = hashCombine(pixelHash_, dimension);
-  const uint64_t h2 = mix64(h);
+Vec2f Sampler::get2DAt(uint32_t dimension) {
+  const uint64_t h = dimensionHash(dimension);
+  const uint64_t h2 = secondHash(dimension);
   // shuffled index i = reverseBits(z); dimension 0 of i is reverseBits(i) = z, whose scramble
   // is reverseBits(lowerBitsPermutation(reverseBits(z), ·)); dimension 1 likewise.
   const uint32_t z = lowerBitsPermutation(reversedIndex_, uint32_t(h));
@@ -122,8 +151,8 @@ Vec2f Sampler::get2DAt(uint32_t dimension) const {
   return {toUnitFloat(x), toUnitFloat(y)};
 }
 
-float Sampler::get1DAt(uint32_t dimension) const {
-  const uint64_t h = hashCombine(pixelHash_, dimension);
+float Sampler::get1DAt(uint32_t dimension) {
+  const uint64_t h = dimensionHash(dimension);
   const uint32_t z = lowerBitsPermutation(reversedIndex_, uint32_t(h));
   return toUnitFloat(reverseBits(lowerBitsPermutation(reverseBits(z), uint32_t(h >> 32))));
 }

@@ -35,12 +35,28 @@ class Sampler {
     dimension_ += count;
     return first;
   }
-  float get1DAt(uint32_t dimension) const;
-  Vec2f get2DAt(uint32_t dimension) const;
+  float get1DAt(uint32_t dimension);
+  Vec2f get2DAt(uint32_t dimension);
 
  private:
+  // The scramble seeds of a (pixel, sub-buffer, dimension) do not depend on the sample index,
+  // so they are hashed once per pixel and reused by its other samples (the hashes were a
+  // quarter of the sampler's time). Values never depend on what was cached before.
+  static constexpr uint32_t kCachedDimensions = 64;
+  struct SubBufferSeeds {
+    uint64_t pixelHash = 0;  // hash of (seed, pixel, sub-buffer)
+    bool hasPixelHash = false;
+    uint64_t hasDimension = 0, hasSecond = 0;  // bit d: dimension[d] / second[d] is filled
+    uint64_t dimension[kCachedDimensions];     // hash of (pixel hash, d)
+    uint64_t second[kCachedDimensions];        // mix64 of it, the second coordinate's seed
+  };
+  uint64_t dimensionHash(uint32_t dimension);
+  uint64_t secondHash(uint32_t dimension);
+
   uint64_t seed_;
-  uint64_t pixelHash_ = 0;      // hash of (seed, pixel, sub-buffer)
+  int pixelX_ = -1, pixelY_ = -1;  // the pixel the seeds belong to
+  SubBufferSeeds seeds_[4];
+  SubBufferSeeds* current_ = &seeds_[0];
   uint32_t reversedIndex_ = 0;  // the sample's index in its sub-buffer, bits reversed
   uint32_t dimension_ = 0;
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "renderer/integrator/ray_offset.h"
 #include "renderer/sampling/warps.h"
 
 namespace chorus::render {
@@ -20,6 +21,22 @@ float triangleArea(const MeshDesc& mesh, uint32_t primID) {
   const uint32_t* idx = &mesh.indices[3 * size_t(primID)];
   return 0.5f * length(cross(mesh.positions[idx[1]] - mesh.positions[idx[0]],
                              mesh.positions[idx[2]] - mesh.positions[idx[0]]));
+}
+
+// The side every point of a triangle faces, when it is the same everywhere: the face normal
+// turned toward the vertex normals (Scene::interaction's rule), which cannot change across the
+// triangle when all three vertex normals lie on one side of it. Zero otherwise.
+Vec3f uniformOrientation(const SceneMesh& sm, uint32_t primID) {
+  const Vec3f ng = sm.faceNormals[primID];
+  if (sm.mesh.normals.empty()) return ng;
+  const uint32_t* idx = &sm.mesh.indices[3 * size_t(primID)];
+  int front = 0, back = 0;
+  for (int v = 0; v < 3; ++v) {
+    const float d = dot(sm.mesh.normals[idx[v]], ng);
+    front += d > 0;
+    back += d < 0;
+  }
+  return front == 3 ? ng : back == 3 ? -ng : Vec3f{};
 }
 
 // glTF KHR_lights_punctual spot falloff: a smooth step between the outer and inner cone,
@@ -64,7 +81,19 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene), environment_(scene.envi
     const float sides = m.doubleSided ? 2.0f : 1.0f;
     for (uint32_t primID = 0; primID < sm.mesh.triangleCount(); ++primID) {
       const float area = triangleArea(sm.mesh, primID);
-      areaLights_.push_back({uint32_t(geomID), primID, area});
+      AreaLight light;
+      light.geomID = uint32_t(geomID);
+      light.primID = primID;
+      light.area = area;
+      const uint32_t* idx = &sm.mesh.indices[3 * size_t(primID)];
+      light.p0 = sm.mesh.positions[idx[0]];
+      light.p1 = sm.mesh.positions[idx[1]];
+      light.p2 = sm.mesh.positions[idx[2]];
+      light.normal = uniformOrientation(sm, primID);
+      light.uniform = m.emissiveTexture < 0 && lengthSquared(light.normal) > 0;
+      light.doubleSided = m.doubleSided;
+      light.Le = m.emissive;
+      areaLights_.push_back(light);
       lights_.push_back({Kind::Area, uint32_t(areaLights_.size() - 1)});
       power.push_back(kPi * sides * area * meanLe.luminance());
     }
@@ -125,25 +154,27 @@ std::optional<LightSample> LightSet::sampleArea(const AreaLight& light, const Ve
                                                 Vec2f u) const {
   if (!(light.area > 0)) return std::nullopt;
   const Vec2f b = sampleUniformTriangle(u);
-  const MeshDesc& mesh = scene_->data().meshes[light.geomID].mesh;
-  const uint32_t* idx = &mesh.indices[3 * size_t(light.primID)];
-  const Vec3f p = mesh.positions[idx[0]] * b.x + mesh.positions[idx[1]] * b.y +
-                  mesh.positions[idx[2]] * (1 - b.x - b.y);
+  const float b2 = 1 - b.x - b.y;
+  const Vec3f p = light.p0 * b.x + light.p1 * b.y + light.p2 * b2;
   const Vec3f toLight = p - ref;
   const float distanceSquared = lengthSquared(toLight);
   if (!(distanceSquared > 0)) return std::nullopt;
   const Vec3f wi = toLight / std::sqrt(distanceSquared);
-  const Scene::EmitterPoint e =
-      scene_->emitterPoint(light.geomID, light.primID, b.y, 1 - b.x - b.y, wi);
-  const float cosLight = std::abs(dot(e.geometricNormal, wi));
-  if (!(cosLight > 0)) return std::nullopt;
   LightSample s;
-  s.Li = e.Le;
+  if (light.uniform) {
+    s.nLight = light.normal;
+    if (light.doubleSided || dot(wi, light.normal) < 0) s.Li = light.Le;
+  } else {
+    const Scene::EmitterPoint e = scene_->emitterPoint(light.geomID, light.primID, b.y, b2, wi);
+    s.nLight = e.geometricNormal;
+    s.Li = e.Le;
+  }
+  const float cosLight = std::abs(dot(s.nLight, wi));
+  if (!(cosLight > 0)) return std::nullopt;
   s.wi = wi;
   s.pdf = distanceSquared / (cosLight * light.area);
-  s.pLight = e.position;
-  s.pLightError = e.positionError;
-  s.nLight = e.geometricNormal;
+  s.pLight = p;
+  s.pLightError = barycentricPositionError(light.p0, light.p1, light.p2, b.x, b.y, b2);
   return s;
 }
 

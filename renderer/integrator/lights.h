@@ -49,8 +49,15 @@ class LightSet {
     uint32_t index;  // into areaLights_ or the scene's punctual lights
   };
   struct AreaLight {
-    uint32_t geomID, primID;
-    float area;
+    uint32_t geomID = 0, primID = 0;
+    float area = 0;
+    Vec3f p0, p1, p2;  // world-space corners
+    // Set when the whole triangle has one oriented normal and one emission (flat or no vertex
+    // normals, untextured emission), which is then kept here: no scene lookups per sample.
+    bool uniform = false;
+    bool doubleSided = false;
+    Vec3f normal;
+    Rgb Le;
   };
 
   std::optional<LightSample> sampleArea(const AreaLight& light, const Vec3f& ref, Vec2f u) const;

@@ -258,6 +258,11 @@ BsdfEval Bsdf::evalCanonical(const Context& c, Vec3f wi) const {
 
 BsdfEval Bsdf::evaluate(Vec3f wo, Vec3f wi) const {
   if (!grazingSafe(wo) || !grazingSafe(wi)) return {};
+  if (lambertian_) {
+    // evalCanonical's diffuse term, reflection only (the lobe weight is 1, or 0 when black).
+    if ((wo.z < 0) != (wi.z < 0) || !(m_.baseColor.average() > 0)) return {};
+    return {m_.baseColor * kInvPi, cosineHemispherePdfSolidAngle(std::abs(wi.z))};
+  }
   const Context c = context(wo);
   return evalCanonical(c, c.flip ? mirrorZ(wi) : wi);
 }
@@ -272,6 +277,15 @@ float Bsdf::pdf(Vec3f wo, Vec3f wi) const {
 
 std::optional<BsdfSample> Bsdf::sample(Vec3f woAsGiven, float uLobe, Vec2f u) const {
   if (!grazingSafe(woAsGiven) || !finiteInputs(woAsGiven, uLobe, u)) return std::nullopt;
+  if (lambertian_) {
+    // The diffuse branch below, without the lobe choice and the general evaluation.
+    if (!(m_.baseColor.average() > 0)) return std::nullopt;
+    const Vec3f wi = sampleCosineHemisphere(u);
+    if (!grazingSafe(wi)) return std::nullopt;
+    const float pdf = cosineHemispherePdfSolidAngle(wi.z);
+    if (!(pdf > 0)) return std::nullopt;
+    return BsdfSample{m_.baseColor * kInvPi, woAsGiven.z < 0 ? mirrorZ(wi) : wi, pdf, false, false};
+  }
   const Context c = context(woAsGiven);
   const Vec3f wo = c.wo;
   const LobeWeights& w = c.weights;

@@ -54,6 +54,32 @@ TEST(Png, TonemappersProduceHandComputedBytes) {
   EXPECT_EQ(decode(dir / "exposure.png", 1)[0], 188);
 }
 
+// Every channel layout, at a size with many rows and odd widths: an independent decoder
+// (stb_image) reads back exactly the bytes the tonemapping chain gives for each value.
+TEST(Png, DecodesToTheDisplayBytesForEveryLayout) {
+  test::TempDir dir;
+  for (int channels : {1, 3, 4}) {
+    Image image(37, 29, channels);
+    for (int y = 0; y < image.height(); ++y)
+      for (int x = 0; x < image.width(); ++x)
+        for (int c = 0; c < channels; ++c)  // a ramp with jumps, values outside [0, 1] too
+          image(x, y, c) =
+              1.3f * std::fmod(0.037f * float(x * (c + 1)) + 0.11f * float(y), 1.0f) - 0.1f;
+    const auto path = dir / ("layout" + std::to_string(channels) + ".png");
+    writePng(path, image, {0.0f, Tonemapper::Clamp});
+    const auto bytes = decode(path, channels);
+    ASSERT_EQ(bytes.size(), image.size());
+    for (size_t i = 0; i < bytes.size(); ++i) {
+      const float v = image.data()[i];
+      const uint8_t expected =
+          channels == 4 && i % 4 == 3
+              ? uint8_t(std::lround(255.0f * std::clamp(v, 0.0f, 1.0f)))  // alpha: linear
+              : toDisplayByte(v, {0.0f, Tonemapper::Clamp});
+      ASSERT_EQ(bytes[i], expected) << channels << " channels, byte " << i;
+    }
+  }
+}
+
 TEST(Png, RejectsUnsupportedChannelCounts) {
   test::TempDir dir;
   EXPECT_THROW(writePng(dir / "x.png", Image(2, 2, 2)), Error);

@@ -12,7 +12,7 @@ build_dir=${BUILD_DIR:-build}
 jobs=${JOBS:-$(nproc)}
 
 packages=(g++ cmake make pkg-config libembree-dev libtinygltf-dev libopenexr-dev libtbb-dev
-          libgtest-dev libeigen3-dev libcli11-dev libstb-dev nlohmann-json3-dev)
+          libgtest-dev libeigen3-dev libcli11-dev libstb-dev nlohmann-json3-dev zlib1g-dev)
 # The report test loads report.html in a real browser.
 [ "$mode" = test ] && packages+=(chromium)
 

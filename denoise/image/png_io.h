@@ -1,5 +1,5 @@
 #pragma once
-// 8-bit sRGB PNG output through stb_image_write: to a file, or to memory (for data URIs).
+// 8-bit sRGB PNG output (zlib): to a file, or to memory (for data URIs).
 #include <cstdint>
 #include <filesystem>
 #include <vector>

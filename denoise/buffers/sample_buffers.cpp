@@ -1,6 +1,10 @@
 #include "denoise/buffers/sample_buffers.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <stdexcept>
+#include <vector>
 
 namespace chorus {
 
@@ -76,34 +80,44 @@ SubBuffer merge(const std::vector<const SubBuffer*>& parts) {
 
   SubBuffer out = SubBuffer::zeros(w, h);
   const size_t pixels = size_t(w) * size_t(h);
-  for (size_t i = 0; i < pixels; ++i) {
-    double n = 0;
-    for (const SubBuffer* p : parts) n += p->sampleCount.data()[i];
-    out.sampleCount.data()[i] = float(n);
-  }
-  for (Quantity q : kAllQuantities) {
-    const int channels = channelCount(q);
-    for (size_t i = 0; i < pixels; ++i) {
-      for (int c = 0; c < channels; ++c) {
-        const size_t e = i * size_t(channels) + size_t(c);
-        // Chan et al.: combine (n, mean, M2) pairwise; M2 = V n (n - 1).
-        double n = 0, mean = 0, m2 = 0;
-        for (const SubBuffer* p : parts) {
-          const double nb = p->sampleCount.data()[i];
-          if (nb <= 0) continue;
-          const double meanB = p->get(q).mean.data()[e];
-          const double m2B = double(p->get(q).varianceOfMean.data()[e]) * nb * (nb - 1);
-          const double total = n + nb;
-          const double delta = meanB - mean;
-          mean += delta * nb / total;
-          m2 += m2B + delta * delta * n * nb / total;
-          n = total;
+  // In parallel over blocks of pixels, with each plane's pointers looked up once per block: the
+  // merges behind a render's A, B and full inputs were a tenth of a 4-spp preview, serially.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, 16384), [&](const auto& block) {
+    for (size_t i = block.begin(); i < block.end(); ++i) {
+      double n = 0;
+      for (const SubBuffer* p : parts) n += p->sampleCount.data()[i];
+      out.sampleCount.data()[i] = float(n);
+    }
+    std::vector<const float*> partMean(parts.size()), partVariance(parts.size());
+    for (Quantity q : kAllQuantities) {
+      const size_t channels = size_t(channelCount(q));
+      for (size_t k = 0; k < parts.size(); ++k) {
+        partMean[k] = parts[k]->get(q).mean.data();
+        partVariance[k] = parts[k]->get(q).varianceOfMean.data();
+      }
+      float* outMean = out.get(q).mean.data();
+      float* outVariance = out.get(q).varianceOfMean.data();
+      for (size_t i = block.begin(); i < block.end(); ++i) {
+        for (size_t e = i * channels; e < (i + 1) * channels; ++e) {
+          // Chan et al.: combine (n, mean, M2) pairwise; M2 = V n (n - 1).
+          double n = 0, mean = 0, m2 = 0;
+          for (size_t k = 0; k < parts.size(); ++k) {
+            const double nb = parts[k]->sampleCount.data()[i];
+            if (nb <= 0) continue;
+            const double meanB = partMean[k][e];
+            const double m2B = double(partVariance[k][e]) * nb * (nb - 1);
+            const double total = n + nb;
+            const double delta = meanB - mean;
+            mean += delta * nb / total;
+            m2 += m2B + delta * delta * n * nb / total;
+            n = total;
+          }
+          outMean[e] = float(mean);
+          outVariance[e] = n >= 2 ? float(m2 / (n * (n - 1))) : 0.0f;
         }
-        out.get(q).mean.data()[e] = float(mean);
-        out.get(q).varianceOfMean.data()[e] = n >= 2 ? float(m2 / (n * (n - 1))) : 0.0f;
       }
     }
-  }
+  });
   return out;
 }
 

@@ -98,7 +98,7 @@ void Sampler::startPixelSample(int px, int py, uint32_t indexInSubBuffer, int su
   if (px != pixelX_ || py != pixelY_) {
     pixelX_ = px;
     pixelY_ = py;
-    for (SubBufferSeeds& s : seeds_) s.hasPixelHash = false, s.hasDimension = s.hasSecond = 0;
+    for (SubBufferSeeds& s : seeds_) s.hasPixelHash = false, s.filled = 0;
   }
   current_ = &seeds_[subBuffer & 3];
   if (!current_->hasPixelHash) {
@@ -111,24 +111,21 @@ void Sampler::startPixelSample(int px, int py, uint32_t indexInSubBuffer, int su
   dimension_ = 0;
 }
 
-uint64_t Sampler::dimensionHash(uint32_t dimension) {
-  if (dimension >= kCachedDimensions) return hashCombine(current_->pixelHash, dimension);
-  const uint64_t bit = uint64_t(1) << dimension;
-  if (!(current_->hasDimension & bit)) {
-    current_->dimension[dimension] = hashCombine(current_->pixelHash, dimension);
-    current_->hasDimension |= bit;
-  }
-  return current_->dimension[dimension];
+// The cached seeds when present (inlined into the draws), else computed out of line.
+inline Sampler::DimensionSeeds Sampler::seeds(uint32_t dimension) {
+  if (dimension < kCachedDimensions && (current_->filled >> dimension & 1))
+    return current_->seeds[dimension];
+  return computeSeeds(dimension);
 }
 
-uint64_t Sampler::secondHash(uint32_t dimension) {
-  if (dimension >= kCachedDimensions) return mix64(dimensionHash(dimension));
-  const uint64_t bit = uint64_t(1) << dimension;
-  if (!(current_->hasSecond & bit)) {
-    current_->second[dimension] = mix64(dimensionHash(dimension));
-    current_->hasSecond |= bit;
+Sampler::DimensionSeeds Sampler::computeSeeds(uint32_t dimension) {
+  const uint64_t h = hashCombine(current_->pixelHash, dimension);
+  const DimensionSeeds s{h, mix64(h)};
+  if (dimension < kCachedDimensions) {
+    current_->seeds[dimension] = s;
+    current_->filled |= uint64_t(1) << dimension;
   }
-  return current_->second[dimension];
+  return s;
 }
 
 // Every call draws from its own (0,2)-sequence: the pair of dimensions gets an independent
@@ -141,8 +138,8 @@ Vec2f Sampler::get2D() {
 }
 
 Vec2f Sampler::get2DAt(uint32_t dimension) {
-  const uint64_t h = dimensionHash(dimension);
-  const uint64_t h2 = secondHash(dimension);
+  const DimensionSeeds seed = seeds(dimension);
+  const uint64_t h = seed.first, h2 = seed.second;
   // shuffled index i = reverseBits(z); dimension 0 of i is reverseBits(i) = z, whose scramble
   // is reverseBits(lowerBitsPermutation(reverseBits(z), ·)); dimension 1 likewise.
   const uint32_t z = lowerBitsPermutation(reversedIndex_, uint32_t(h));
@@ -152,7 +149,7 @@ Vec2f Sampler::get2DAt(uint32_t dimension) {
 }
 
 float Sampler::get1DAt(uint32_t dimension) {
-  const uint64_t h = dimensionHash(dimension);
+  const uint64_t h = seeds(dimension).first;
   const uint32_t z = lowerBitsPermutation(reversedIndex_, uint32_t(h));
   return toUnitFloat(reverseBits(lowerBitsPermutation(reverseBits(z), uint32_t(h >> 32))));
 }

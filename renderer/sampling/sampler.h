@@ -43,15 +43,18 @@ class Sampler {
   // so they are hashed once per pixel and reused by its other samples (the hashes were a
   // quarter of the sampler's time). Values never depend on what was cached before.
   static constexpr uint32_t kCachedDimensions = 64;
+  struct DimensionSeeds {
+    uint64_t first;   // hash of (pixel hash, dimension): index shuffle and first coordinate
+    uint64_t second;  // mix64 of it: the second coordinate of a 2D draw
+  };
   struct SubBufferSeeds {
     uint64_t pixelHash = 0;  // hash of (seed, pixel, sub-buffer)
     bool hasPixelHash = false;
-    uint64_t hasDimension = 0, hasSecond = 0;  // bit d: dimension[d] / second[d] is filled
-    uint64_t dimension[kCachedDimensions];     // hash of (pixel hash, d)
-    uint64_t second[kCachedDimensions];        // mix64 of it, the second coordinate's seed
+    uint64_t filled = 0;  // bit d: seeds[d] is set
+    DimensionSeeds seeds[kCachedDimensions];
   };
-  uint64_t dimensionHash(uint32_t dimension);
-  uint64_t secondHash(uint32_t dimension);
+  DimensionSeeds seeds(uint32_t dimension);
+  [[gnu::noinline]] DimensionSeeds computeSeeds(uint32_t dimension);
 
   uint64_t seed_;
   int pixelX_ = -1, pixelY_ = -1;  // the pixel the seeds belong to

@@ -7,10 +7,12 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfTestFile.h>
+#include <ImfThreading.h>
 
 #include <algorithm>
 #include <fstream>
 #include <map>
+#include <thread>
 
 #include "denoise/util/atomic_file.h"
 #include "denoise/util/error.h"
@@ -19,6 +21,18 @@ namespace chorus {
 namespace fs = std::filesystem;
 
 namespace {
+
+// OpenEXR compresses and decompresses blocks of lines on its own thread pool, which is empty
+// until sized: writing a 512², K = 4 render.exr took 1.6 s on one thread. Sized once, to the
+// machine.
+int exrThreads() {
+  static const int threads = [] {
+    const int n = int(std::max(1u, std::thread::hardware_concurrency()));
+    Imf::setGlobalThreadCount(n);
+    return n;
+  }();
+  return threads;
+}
 
 std::vector<std::string> suffixesFor(int channels) {
   switch (channels) {
@@ -88,6 +102,9 @@ void writeExr(const fs::path& path, const std::vector<ExrLayer>& layers, ExrPixe
   writeAtomically(path, [&](const fs::path& tmp) {
     Imf::Header header(width, height);
     header.compression() = Imf::ZIP_COMPRESSION;
+    // Level 1: a render.exr of noisy floats shrinks about as much as at the default level (24.9
+    // against 24.3 MB for 512², K = 4) in three quarters of the time.
+    header.zipCompressionLevel() = 1;
     Imf::FrameBuffer frame;
     // OpenEXR does not convert float to half on output: half layers are converted here.
     std::vector<std::vector<half>> halfCopies;
@@ -113,7 +130,7 @@ void writeExr(const fs::path& path, const std::vector<ExrLayer>& layers, ExrPixe
       }
     }
     try {
-      Imf::OutputFile file(tmp.c_str(), header);
+      Imf::OutputFile file(tmp.c_str(), header, exrThreads());
       file.setFrameBuffer(frame);
       file.writePixels(height);
     } catch (const std::exception& e) {
@@ -129,7 +146,7 @@ void writeExr(const fs::path& path, const Image& image, ExrPixelType type) {
 std::vector<ExrLayer> readExr(const fs::path& path) {
   checkIsExr(path);
   try {
-    Imf::InputFile file(path.c_str());
+    Imf::InputFile file(path.c_str(), exrThreads());
     const Imath::Box2i window = file.header().dataWindow();
     const int width = window.max.x - window.min.x + 1;
     const int height = window.max.y - window.min.y + 1;

@@ -219,7 +219,7 @@ TEST(RenderCli, PreviewWritesOnlyThePngAndStats) {
   EXPECT_EQ(files, (std::vector<std::string>{"denoised.png", "stats.json"}));
   const json stats = readJson(out / "stats.json");
   EXPECT_EQ(stats["spp"], 4);
-  EXPECT_EQ(stats["denoise"]["methods"], json({"atrous", "bilateral:sigmaS=2:sigmaC=0"}));
+  EXPECT_EQ(stats["denoise"]["methods"], json({"atrous", "atrous:iterations=4:sigmaL=8:sigmaN=16"}));
   EXPECT_EQ(stats["denoise"]["weight_filter"], "none");
 }
 

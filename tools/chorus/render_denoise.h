@@ -19,7 +19,7 @@ namespace chorus::cli {
 // "Choosing the default members": the sweep evidence behind both). Previews also skip the
 // weight filter unless --weight-filter is given (it cost more than it gained at 4 spp).
 inline constexpr const char* kDefaultDenoise = "nfor,rdfc,atrous";
-inline constexpr const char* kPreviewDenoise = "atrous,bilateral:sigmaS=2:sigmaC=0";
+inline constexpr const char* kPreviewDenoise = "atrous,atrous:iterations=4:sigmaL=8:sigmaN=16";
 
 struct DenoiseStage {
   std::vector<std::string> specs;       // empty: render only (--denoise none)

@@ -26,8 +26,11 @@ EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers) {
   if (k < 2 || k % 2 != 0)
     throw Error("the ensemble needs an even number of independent sub-buffers (2 or 4), got " +
                 std::to_string(k));
-  return {buffers.input(BufferPart::HalfA), buffers.input(BufferPart::HalfB),
-          buffers.input(BufferPart::Full)};
+  EnsembleSources sources{buffers.input(BufferPart::HalfA), buffers.input(BufferPart::HalfB), {}};
+  // The full buffer's halves are the half inputs' wholes: copied rather than merged again.
+  sources.full.whole = buffers.part(BufferPart::Full);
+  sources.full.halves = std::array<SubBuffer, 2>{sources.a.whole, sources.b.whole};
+  return sources;
 }
 
 EnsembleSources sourcesFromHalves(const DenoiseInput& input) {

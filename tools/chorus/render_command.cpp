@@ -45,8 +45,10 @@ DenoiseStage denoiseStageOf(const RenderArgs& args) {
   if (args.preview && !args.ensemble.weightFilterGiven) options.filter.enabled = false;
   const std::string list = args.denoiseGiven ? args.denoise : args.preview ? "preview" : "default";
   DenoiseStage stage = DenoiseStage::parse(list, options, !args.preview);
-  if (stage.enabled() && args.splits != 0 && args.splits != 4)
-    throw Error("--denoise needs 4 sub-buffers: omit --splits or give --splits 4");
+  const int needed = stage.splitsNeeded();
+  if (stage.enabled() && args.splits != 0 && args.splits < needed)
+    throw Error("--denoise " + stage.label() + " needs " + std::to_string(needed) +
+                " sub-buffers: omit --splits or give --splits " + std::to_string(needed));
   return stage;
 }
 

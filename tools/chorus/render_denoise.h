@@ -33,9 +33,12 @@ struct DenoiseStage {
 
   std::string label() const;  // "nfor,rdfc,..."
   bool enabled() const { return !specs.empty(); }
-  int splitsNeeded() const { return enabled() ? 4 : 1; }
+  // Sub-buffers the render needs: 4 when a member needs two halves of its own input (it then
+  // runs on quarters inside each half: NFOR, RDFC, dual-buffer NL-means), else 2 (the ensemble's
+  // halves A and B); 1 without denoising. Fewer sub-buffers mean less film to fill and merge.
+  int splitsNeeded() const;
 
-  // Runs the members and the combiner on `sources` (sourcesFromBuffers of a K = 4 render),
+  // Runs the members and the combiner on `sources` (sourcesFromBuffers of the render),
   // writes denoised.png and, unless a preview, denoised.exr, weights.exr and <member>.exr to
   // `dir`, and adds every stage's seconds to stats["seconds"] and, with a reference, the
   // metrics of the noisy input, each member and the result to stats["metrics"].

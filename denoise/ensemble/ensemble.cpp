@@ -40,6 +40,12 @@ void checkMembersCanRun(const EnsembleSources& sources, std::span<const Ensemble
   }
 }
 
+int splitsNeeded(std::span<const EnsembleMember> members) {
+  for (const EnsembleMember& member : members)
+    if (member.denoiser->requirements().halves) return 4;
+  return 2;
+}
+
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
                                           std::vector<StageTime>* times) {

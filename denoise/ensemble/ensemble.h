@@ -30,6 +30,11 @@ std::vector<EnsembleMember> membersFromSpecs(std::span<const std::string> specs)
 // Tungsten directories: only the full buffer has halves).
 void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members);
 
+// Sub-buffers a render needs for these members: 4 when one needs two halves of its own input (it
+// then runs on quarters inside each half: NFOR, RDFC, dual-buffer NL-means), else 2 (the
+// ensemble's halves A and B). Fewer sub-buffers mean less film to fill and merge.
+int splitsNeeded(std::span<const EnsembleMember> members);
+
 // Every member on sources.a, .b and .full, in parallel. Appends "<label>/A", "<label>/B",
 // "<label>/full" (the time of each run) and "bases" (wall time of all of them) to `times`.
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,

@@ -91,11 +91,11 @@ int main(int argc, char** argv) {
   render::RenderOptions options;
   options.width = options.height = size;
   options.spp = spp;
-  options.splits = 4;
   options.threads = threads;
   CombineOptions previewOptions;
   previewOptions.filter.enabled = false;  // as `chorus render --preview`
   const Ensemble ensemble(membersFromSpecs(splitMethodList(preview)), previewOptions);
+  options.splits = splitsNeeded(ensemble.members());  // as `chorus render`
 
   runOnce(scene, options, ensemble);  // warm-up: page faults, TBB start-up, dispatch tables
   std::vector<Run> runs;
@@ -121,8 +121,10 @@ int main(int argc, char** argv) {
                     : std::filesystem::path(cache) / ("preview-" + std::to_string(size) + "-" +
                                                       std::to_string(referenceSpp) + "spp.exr"),
       "bench_preview");
-  const Run fullRun =
-      runOnce(scene, options, Ensemble(membersFromSpecs(splitMethodList(full)), {}));
+  const Ensemble fullEnsemble(membersFromSpecs(splitMethodList(full)), {});
+  render::RenderOptions fullOptions = options;
+  fullOptions.splits = splitsNeeded(fullEnsemble.members());
+  const Run fullRun = runOnce(scene, fullOptions, fullEnsemble);
   std::printf("relMSE against a %d-spp reference at %d spp:\n", referenceSpp, spp);
   std::printf("  noisy                    %.5f\n", relMse(best.noisy, reference));
   std::printf("  preview (%s)  %.5f  (%.3f s)\n", preview.c_str(), relMse(best.image, reference),

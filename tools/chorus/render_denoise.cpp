@@ -25,13 +25,6 @@ DenoiseStage DenoiseStage::parse(const std::string& list, CombineOptions options
   return stage;
 }
 
-int DenoiseStage::splitsNeeded() const {
-  if (!enabled()) return 1;
-  for (const EnsembleMember& member : members)
-    if (member.denoiser->requirements().halves) return 4;
-  return 2;
-}
-
 double DenoiseStage::run(const EnsembleSources& sources, const std::filesystem::path& dir,
                          nlohmann::ordered_json& stats, const Image* reference) const {
   const Ensemble ensemble(members, options);

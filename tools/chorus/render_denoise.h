@@ -33,10 +33,8 @@ struct DenoiseStage {
 
   std::string label() const;  // "nfor,rdfc,..."
   bool enabled() const { return !specs.empty(); }
-  // Sub-buffers the render needs: 4 when a member needs two halves of its own input (it then
-  // runs on quarters inside each half: NFOR, RDFC, dual-buffer NL-means), else 2 (the ensemble's
-  // halves A and B); 1 without denoising. Fewer sub-buffers mean less film to fill and merge.
-  int splitsNeeded() const;
+  // Sub-buffers the render needs (chorus::splitsNeeded of the members; 1 without denoising).
+  int splitsNeeded() const { return enabled() ? chorus::splitsNeeded(members) : 1; }
 
   // Runs the members and the combiner on `sources` (sourcesFromBuffers of the render),
   // writes denoised.png and, unless a preview, denoised.exr, weights.exr and <member>.exr to

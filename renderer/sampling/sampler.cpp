@@ -98,14 +98,16 @@ void Sampler::startPixelSample(int px, int py, uint32_t indexInSubBuffer, int su
   if (px != pixelX_ || py != pixelY_) {
     pixelX_ = px;
     pixelY_ = py;
-    for (SubBufferSeeds& s : seeds_) s.hasPixelHash = false, s.filled = 0;
+    for (SubBufferSeeds& s : seeds_) s.subBuffer = -1;
   }
-  current_ = &seeds_[subBuffer & 3];
-  if (!current_->hasPixelHash) {
+  // One slot per sub-buffer (K ≤ 4 in practice); a slot holding another sub-buffer starts over.
+  current_ = &seeds_[uint32_t(subBuffer) % kSeedSlots];
+  if (current_->subBuffer != subBuffer) {
     uint64_t h = hashCombine(mix64(seed_), uint64_t(uint32_t(px)));
     h = hashCombine(h, uint64_t(uint32_t(py)));
     current_->pixelHash = hashCombine(h, uint64_t(uint32_t(subBuffer)));
-    current_->hasPixelHash = true;
+    current_->subBuffer = subBuffer;
+    current_->filled = 0;
   }
   reversedIndex_ = reverseBits(indexInSubBuffer);
   dimension_ = 0;

@@ -48,17 +48,18 @@ class Sampler {
     uint64_t second;  // mix64 of it: the second coordinate of a 2D draw
   };
   struct SubBufferSeeds {
+    int subBuffer = -1;      // whose seeds these are (−1: none yet for this pixel)
     uint64_t pixelHash = 0;  // hash of (seed, pixel, sub-buffer)
-    bool hasPixelHash = false;
-    uint64_t filled = 0;  // bit d: seeds[d] is set
+    uint64_t filled = 0;     // bit d: seeds[d] is set
     DimensionSeeds seeds[kCachedDimensions];
   };
+  static constexpr uint32_t kSeedSlots = 4;
   DimensionSeeds seeds(uint32_t dimension);
   [[gnu::noinline]] DimensionSeeds computeSeeds(uint32_t dimension);
 
   uint64_t seed_;
   int pixelX_ = -1, pixelY_ = -1;  // the pixel the seeds belong to
-  SubBufferSeeds seeds_[4];
+  SubBufferSeeds seeds_[kSeedSlots];
   SubBufferSeeds* current_ = &seeds_[0];
   uint32_t reversedIndex_ = 0;  // the sample's index in its sub-buffer, bits reversed
   uint32_t dimension_ = 0;

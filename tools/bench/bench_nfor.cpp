@@ -3,11 +3,16 @@
 //   speed:   seconds per megapixel on --threads threads (default 2), on one case's input
 //            buffers tiled to --size × --size (default 1024 × 1024);
 //   quality: relMSE against the reference for the six cases, next to Tungsten's own NFOR
-//            output, and how close our NFOR is to Tungsten's.
+//            output, and how close our NFOR is to Tungsten's;
+//   --outputs DIR: our NFOR outputs (the speed case and the six quality cases) are compared
+//            with DIR/<name>.exr where those exist (max |difference|, relMSE) and written there
+//            where not — run once before a change and once after to see what it changed.
 #include <tbb/global_control.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -79,18 +84,40 @@ double seconds(Fn&& fn) {
   return timed(fn).wall;
 }
 
+// Compares `image` with dir/name.exr if that exists, else writes it there. No-op for an empty dir.
+void compareOrKeep(const std::filesystem::path& dir, const std::string& name, const Image& image) {
+  if (dir.empty()) return;
+  const std::filesystem::path path = dir / (name + ".exr");
+  if (!std::filesystem::exists(path)) {
+    std::filesystem::create_directories(dir);
+    writeExr(path, image);
+    return;
+  }
+  const Image before = readExrLayer(path);
+  double maxDiff = 0, maxRel = 0;
+  for (size_t i = 0; i < image.size(); ++i) {
+    const double a = image.data()[i], b = before.data()[i], diff = std::abs(a - b);
+    maxDiff = std::max(maxDiff, diff);
+    maxRel = std::max(maxRel, diff / std::max(1e-3, std::abs(b)));
+  }
+  std::printf("  vs %s: max |diff| %.3e, max |diff|/max(1e-3, |before|) %.3e, relMSE %.3e\n",
+              path.c_str(), maxDiff, maxRel, relMse(image, before));
+}
+
 int run(int argc, char** argv) {
   CLI::App app("Speed (s/Mpx) and quality (relMSE) of nfor and nlm on the Tungsten peer data");
   std::string shared = "../shared";
   int threads = 2, size = 1024;
   std::string speedCase = "room/spp4";
   bool skipSpeed = false, skipQuality = false;
+  std::string outputs;
   app.add_option("--shared", shared, "the shared data directory");
   app.add_option("--threads", threads, "TBB threads");
   app.add_option("--size", size, "side of the tiled image for the speed measurement");
   app.add_option("--case", speedCase, "the peer case tiled for the speed measurement");
   app.add_flag("--skip-speed", skipSpeed);
   app.add_flag("--skip-quality", skipQuality);
+  app.add_option("--outputs", outputs, "compare our NFOR outputs with those kept here (or keep)");
   CLI11_PARSE(app, argc, argv);
   const std::filesystem::path root = std::filesystem::path(shared) / "peers/tungsten-nfor";
   if (!std::filesystem::is_directory(root)) throw fileError(root, "no such directory");
@@ -99,7 +126,8 @@ int run(int argc, char** argv) {
   if (!skipSpeed) {
     const DenoiseInput input = tiled(readTungstenDirectory(root / speedCase), size);
     const double mpx = double(size) * size / 1e6;
-    const Timing nfor = timed([&] { NforDenoiser().run(input); });
+    Image output;
+    const Timing nfor = timed([&] { output = NforDenoiser().run(input); });
     const Timing nlm = timed([&] { DualBufferNlMeans().run(input); });
     // cpu / threads is what the wall clock would be on otherwise idle cores with perfect
     // scaling: a load-independent figure next to the wall clock.
@@ -108,6 +136,7 @@ int run(int argc, char** argv) {
     for (const auto& [name, t] : {std::pair{"nfor", nfor}, std::pair{"nlm", nlm}})
       std::printf("  %-6s %9.2f %9.2f %14.2f\n", name, t.wall / mpx, t.cpu / mpx,
                   t.cpu / mpx / threads);
+    compareOrKeep(outputs, "speed", output);
   }
   if (!skipQuality) {
     std::printf(
@@ -129,6 +158,7 @@ int run(int argc, char** argv) {
                     relMse(input.whole.color.mean, reference), tungRef, oursRef, oursRef / tungRef,
                     relMse(ours, tungsten) / relMse(input.whole.color.mean, tungsten),
                     relMse(nlm, reference), time);
+        compareOrKeep(outputs, std::string(scene) + "_" + spp, ours);
       }
     }
   }

@@ -9,73 +9,194 @@
 #include <stdexcept>
 #include <vector>
 
-#include "denoise/image/planar_image.h"
-#include "denoise/base/filters/simd_quad.h"
+#include "denoise/base/bordered_planes.h"
+#include "denoise/util/simd_clones.h"
+
+// The kernels below are built for AVX-512F, AVX2 and the baseline (simd_clones.h). Contraction
+// into FMA is off for all of this file, so that every build gives the same bits; the pragma
+// comes after the includes, and every helper the kernels inline is defined below it (GCC does
+// not inline across different optimisation options).
+#pragma GCC optimize("fp-contract=off")
+// Helpers pass 64-byte vectors by value; they are internal and inlined, so the baseline ABI's
+// note that such values go through memory without AVX-512 does not matter.
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace chorus {
 namespace {
 
-constexpr int kTileSize = 32;
-constexpr int kLanes = 8;  // partial sums per dot product (vectorised, fixed summation order)
+// Centres are processed kLanes at a time, one per vector lane: the kLanes consecutive centres
+// of a tile row share every window offset δ, so the weights w_δ(p), the neighbours' features
+// and the data are contiguous vector loads and each lane's sums keep a fixed order (δ in raster
+// order) whatever the vector width of the build.
+constexpr int kTileSize = 32;  // tile side; tiles are always kTileSize wide (see TileResult)
+constexpr int kLanes = 16;
+static_assert(kTileSize % kLanes == 0);
+using Lanes = float __attribute__((vector_size(kLanes * sizeof(float))));
 
-inline float laneSum(Quad lo, Quad hi) {
-  return ((lo[0] + hi[0]) + (lo[1] + hi[1])) + ((lo[2] + hi[2]) + (lo[3] + hi[3]));
+inline Lanes loadLanes(const float* p) {
+  Lanes v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
 }
 
-// Σ_i w[i] a[i] b[i] over n (a multiple of kLanes) values, lanes summed in a fixed order.
-float weightedDot(const float* w, const float* a, const float* b, int n) {
-  Quad lo = {}, hi = {};
-  for (int i = 0; i < n; i += kLanes) {
-    lo += loadQuad(w + i) * loadQuad(a + i) * loadQuad(b + i);
-    hi += loadQuad(w + i + 4) * loadQuad(a + i + 4) * loadQuad(b + i + 4);
+inline void storeLanes(float* p, Lanes v) {
+  std::memcpy(p, &v, sizeof v);
+}
+
+inline Lanes splat(float v) {
+  return Lanes{} + v;
+}
+
+// Columns of the design matrix and of the data: d ≤ kMaxGramSize, C ≤ kMaxGramRhs.
+constexpr int kMaxColumns = kMaxGramSize + kMaxGramRhs;
+// Sums per centre: the upper triangle of G (d × d) and B (d × C), row by row of G:
+// G_a,a … G_a,d−1, B_a,0 … B_a,C−1.
+constexpr int kMaxSums = kMaxGramSize * (kMaxGramSize + 1) / 2 + kMaxGramSize * kMaxGramRhs;
+
+// The inputs of one tile row group: kLanes centres (x0 … x0 + kLanes − 1, y) and where to read.
+struct Group {
+  int x0, y;
+  int r, d, channels;        // window radius, design columns, data channels
+  const float* weights;      // w_δ(first centre) = weights[offsetIndex(δ) · weightStride]
+  size_t weightStride;       // floats between the weight planes of consecutive offsets
+  const BorderedPlanes* fu;  // features (m planes) then data (C planes), zero border ≥ r + kLanes
+};
+
+// The design-matrix row of window offset δ = (dx, dy) for the kLanes centres, then the data:
+// x = [1, dx, dy, f_j(q) − f_j(p) …, u_c(q) …] with q = p + δ (d design columns, C data).
+[[gnu::always_inline]] inline void designRow(const Group& g, int d, int C, const Lanes* fp, int dx,
+                                             int dy, Lanes* x) {
+  x[0] = splat(1.0f);
+  x[1] = splat(float(dx));
+  x[2] = splat(float(dy));
+  for (int j = 0; j < d - 3; ++j) x[3 + j] = loadLanes(g.fu->row(j, g.y + dy) + g.x0 + dx) - fp[j];
+  for (int c = 0; c < C; ++c) x[d + c] = loadLanes(g.fu->row(d - 3 + c, g.y + dy) + g.x0 + dx);
+}
+
+[[gnu::always_inline]] inline void centreFeatures(const Group& g, int d, Lanes* fp) {
+  for (int j = 0; j < d - 3; ++j) fp[j] = loadLanes(g.fu->row(j, g.y) + g.x0);
+}
+
+// How many offsets ahead accumulateSums prefetches the weights.
+constexpr int kPrefetchOffsets = 4;
+
+inline const float* offsetWeights(const Group& g, int dx, int dy) {
+  const int side = 2 * g.r + 1;
+  return g.weights + size_t((dy + g.r) * side + (dx + g.r)) * g.weightStride;
+}
+
+// The kernels are written once for a shape known at compile time (kD design columns, kC data
+// channels: loops fully unrolled, the design row in registers) or, with kD = kC = 0, read
+// from the group at run time.
+constexpr int kNforColumns = 11, kNforChannels = 3;  // NFOR: 8 features, RGB
+
+// sums (see kMaxSums) = Σ_δ w_δ · x_a · x_b for every centre of the group. Each window row is
+// summed on its own first and then added (two-level summation: shorter float sums). The
+// weights are also copied to `groupWeights` (w_δ at offsetIndex(δ) · kLanes) for the
+// predictions: the table's planes are far apart, and this way it is read only once.
+template <int kD, int kC>
+[[gnu::always_inline]] inline void accumulateSumsOf(const Group& g, Lanes* sums,
+                                                    float* groupWeights) {
+  const int d = kD ? kD : g.d, C = kD ? kC : g.channels;
+  const int count = d * (d + 1) / 2 + d * C;
+  Lanes fp[kMaxGramSize], x[kMaxColumns], rowSums[kMaxSums];
+  centreFeatures(g, d, fp);
+  for (int e = 0; e < count; ++e) sums[e] = Lanes{};
+  for (int dy = -g.r; dy <= g.r; ++dy) {
+    for (int e = 0; e < count; ++e) rowSums[e] = Lanes{};
+    for (int dx = -g.r; dx <= g.r; ++dx) {
+      // Each offset's weights are in another plane of the table, a cache line no hardware
+      // prefetcher predicts: ask for the one a few offsets ahead.
+      __builtin_prefetch(offsetWeights(g, dx, dy) + kPrefetchOffsets * g.weightStride);
+      const Lanes w = loadLanes(offsetWeights(g, dx, dy));
+      storeLanes(groupWeights, w);
+      groupWeights += kLanes;
+      designRow(g, d, C, fp, dx, dy, x);
+      if constexpr (kD > 0) {
+        int e = 0;
+#pragma GCC unroll 32
+        for (int a = 0; a < kD; ++a) {
+          const Lanes wa = w * x[a];
+#pragma GCC unroll 32
+          for (int b = a; b < kD + kC; ++b) rowSums[e++] += wa * x[b];
+        }
+      } else {
+        Lanes* s = rowSums;
+        for (int a = 0; a < d; ++a) {
+          const Lanes wa = w * x[a];
+          for (int b = a; b < d + C; ++b) *s++ += wa * x[b];
+        }
+      }
+    }
+    for (int e = 0; e < count; ++e) sums[e] += rowSums[e];
   }
-  return laneSum(lo, hi);
 }
 
-// Four weighted dot products Σ w·a·b_k sharing w·a.
-void weightedDot4(const float* w, const float* a, const float* b0, const float* b1, const float* b2,
-                  const float* b3, int n, float* out) {
-  Quad l0 = {}, h0 = {}, l1 = {}, h1 = {}, l2 = {}, h2 = {}, l3 = {}, h3 = {};
-  for (int i = 0; i < n; i += kLanes) {
-    const Quad lo = loadQuad(w + i) * loadQuad(a + i);
-    const Quad hi = loadQuad(w + i + 4) * loadQuad(a + i + 4);
-    l0 += lo * loadQuad(b0 + i);
-    h0 += hi * loadQuad(b0 + i + 4);
-    l1 += lo * loadQuad(b1 + i);
-    h1 += hi * loadQuad(b1 + i + 4);
-    l2 += lo * loadQuad(b2 + i);
-    h2 += hi * loadQuad(b2 + i + 4);
-    l3 += lo * loadQuad(b3 + i);
-    h3 += hi * loadQuad(b3 + i + 4);
-  }
-  out[0] = laneSum(l0, h0);
-  out[1] = laneSum(l1, h1);
-  out[2] = laneSum(l2, h2);
-  out[3] = laneSum(l3, h3);
+CHORUS_SIMD_CLONES void accumulateSums(const Group& g, Lanes* sums, float* groupWeights) {
+  if (g.d == kNforColumns && g.channels == kNforChannels)
+    accumulateSumsOf<kNforColumns, kNforChannels>(g, sums, groupWeights);
+  else
+    accumulateSumsOf<0, 0>(g, sums, groupWeights);
 }
 
+// acc_c(q) += w_δ(p) · x_qᵀ β_c(p) and wsum(q) += w_δ(p) for every q = p + δ of the group's
+// windows. beta[a · C + c] holds β_a,c of every lane; acc has C planes then wsum, each
+// `accWidth` wide, positioned so that the group's first centre is at accAt.
+template <int kD, int kC>
+[[gnu::always_inline]] inline void accumulatePredictionsOf(const Group& g,
+                                                           const float* groupWeights,
+                                                           const Lanes* beta, float* acc,
+                                                           size_t accWidth, size_t accPlane,
+                                                           size_t accAt) {
+  const int d = kD ? kD : g.d, C = kD ? kC : g.channels;
+  Lanes fp[kMaxGramSize], x[kMaxColumns];
+  centreFeatures(g, d, fp);
+  for (int dy = -g.r; dy <= g.r; ++dy)
+    for (int dx = -g.r; dx <= g.r; ++dx) {
+      const Lanes w = loadLanes(groupWeights);
+      groupWeights += kLanes;
+      designRow(g, d, 0, fp, dx, dy, x);
+      float* at = acc + accAt + ptrdiff_t(dy) * ptrdiff_t(accWidth) + dx;
+      for (int c = 0; c < C; ++c) {
+        Lanes p = beta[c];
+        for (int a = 1; a < d; ++a) p += beta[a * C + c] * x[a];
+        float* plane = at + size_t(c) * accPlane;
+        storeLanes(plane, loadLanes(plane) + w * p);
+      }
+      float* wsum = at + size_t(C) * accPlane;
+      storeLanes(wsum, loadLanes(wsum) + w);
+    }
+}
+
+CHORUS_SIMD_CLONES void accumulatePredictions(const Group& g, const float* groupWeights,
+                                              const Lanes* beta, float* acc, size_t accWidth,
+                                              size_t accPlane, size_t accAt) {
+  if (g.d == kNforColumns && g.channels == kNforChannels)
+    accumulatePredictionsOf<kNforColumns, kNforChannels>(g, groupWeights, beta, acc, accWidth,
+                                                         accPlane, accAt);
+  else
+    accumulatePredictionsOf<0, 0>(g, groupWeights, beta, acc, accWidth, accPlane, accAt);
+}
+
+// A tile: kTileSize columns starting at x0 (the last tile of a row may extend past the image:
+// its outside centres have weight 0 everywhere), rows [y0, y1) inside the image.
 struct TileResult {
-  PixelRect extent;         // the tile grown by r, clipped: every pixel its windows touch
-  std::vector<float> acc;   // C planes over extent
-  std::vector<float> wsum;  // one plane over extent
+  PixelRect extent;  // the tile grown by r: every pixel its windows touch (may leave the image)
+  std::vector<float> acc;  // C planes of acc, then wsum, over extent
 };
 
 struct ThreadState {
   NlMeansScratch scratch;
-  std::vector<float> table;  // weights [tile pixel][offset]
-  std::vector<float> plus, minus, center;
-  std::vector<float> columns;      // (d + C) columns of the compacted window, stride `stride`
-  std::vector<float> predictions;  // C columns of window predictions
-  std::vector<float> rowWeights;   // w_q of each window row
+  std::vector<float> table;  // weights [offset][tile pixel], tile rows kTileSize wide
+  Lanes sums[kMaxSums];
+  std::vector<float> groupWeights;  // w_δ of one group, offset after offset
 };
 
 class Regression {
  public:
   Regression(const Image& image, const Image& features, const NlMeansWeights& weights,
              const GramTolerances& tol)
-      : u_(image),
-        f_(features),
-        weights_(weights),
+      : weights_(weights),
         tol_(tol),
         width_(image.width()),
         height_(image.height()),
@@ -84,19 +205,23 @@ class Regression {
         channels_(image.channels()),
         m_(features.channels()),
         d_(3 + m_),
-        stride_((side_ * side_ + kLanes - 1) / kLanes * kLanes) {
+        fu_(width_, height_, m_ + channels_, r_ + kLanes) {
     for (int j = 0; j < m_; ++j) {
-      float* plane = f_.plane(j);
-      for (size_t i = 0; i < f_.pixelCount(); ++i)
-        if (!std::isfinite(plane[i])) plane[i] = 0.0f;
+      fu_.set(j, features, j);
+      for (int y = 0; y < height_; ++y) {
+        float* row = fu_.mutableRow(j, y);
+        for (int x = 0; x < width_; ++x)
+          if (!std::isfinite(row[x])) row[x] = 0.0f;
+      }
     }
+    for (int c = 0; c < channels_; ++c) fu_.set(m_ + c, image, c);
   }
 
   Image run() {
     std::vector<PixelRect> tiles;
     for (int y = 0; y < height_; y += kTileSize)
       for (int x = 0; x < width_; x += kTileSize)
-        tiles.push_back({x, y, std::min(width_, x + kTileSize), std::min(height_, y + kTileSize)});
+        tiles.push_back({x, y, x + kTileSize, std::min(height_, y + kTileSize)});
     std::vector<TileResult> results(tiles.size());
     tbb::enumerable_thread_specific<ThreadState> states;
     tbb::parallel_for(size_t(0), tiles.size(),
@@ -109,14 +234,18 @@ class Regression {
 
   // Planes of the weight table are this far apart: a little more than the tile, so that the
   // (2r+1)² weights of one centre do not all fall into the same cache set.
-  static size_t planeStride(const PixelRect& tile) { return size_t(tile.area()) + 16; }
+  static size_t planeStride() { return size_t(kTileSize) * kTileSize + 16; }
 
   // Weights of every offset for every centre of the tile: plane offsetIndex(δ) holds w_δ(p).
+  // Centres outside the image get weight 0 (also at δ = 0), so they contribute nothing.
   void fillWeightTable(const PixelRect& tile, ThreadState& st) const {
-    const size_t stride = planeStride(tile), offsets = size_t(side_ * side_);
+    const size_t stride = planeStride(), offsets = size_t(side_ * side_);
     st.table.resize(stride * offsets);
     float* table = st.table.data();
-    weights_.center(tile, st.scratch, table + size_t(offsetIndex(0, 0)) * stride);
+    float* center = table + size_t(offsetIndex(0, 0)) * stride;
+    weights_.center(tile, st.scratch, center);
+    for (int y = 0; y < tile.height(); ++y)
+      for (int x = width_ - tile.x0; x < kTileSize; ++x) center[y * kTileSize + x] = 0.0f;
     weights_.forEachOffsetPair([&](int dx, int dy) {
       weights_.offsetPair(tile, dx, dy, st.scratch, table + size_t(offsetIndex(dx, dy)) * stride,
                           table + size_t(offsetIndex(-dx, -dy)) * stride);
@@ -125,117 +254,43 @@ class Regression {
 
   void regressTile(const PixelRect& tile, ThreadState& st, TileResult& out) const {
     fillWeightTable(tile, st);
-    out.extent = tile.grown(r_).intersect(PixelRect::image(width_, height_));
-    const size_t extArea = size_t(out.extent.area());
-    out.acc.assign(extArea * size_t(channels_), 0.0f);
-    out.wsum.assign(extArea, 0.0f);
-    const int columns = d_ + channels_;
-    st.columns.assign(size_t(columns) * size_t(stride_), 0.0f);
-    st.predictions.assign(size_t(channels_) * size_t(stride_), 0.0f);
-    st.rowWeights.assign(size_t(stride_), 0.0f);
-    for (int py = tile.y0; py < tile.y1; ++py)
-      for (int px = tile.x0; px < tile.x1; ++px) regressPixel(tile, px, py, st, out);
+    out.extent = tile.grown(r_);
+    const size_t accWidth = size_t(out.extent.width()), accPlane = size_t(out.extent.area());
+    out.acc.assign(accPlane * size_t(channels_ + 1), 0.0f);
+    st.groupWeights.resize(size_t(side_ * side_) * kLanes);
+    for (int y = tile.y0; y < tile.y1; ++y)
+      for (int x0 = tile.x0; x0 < std::min(tile.x1, width_); x0 += kLanes) {
+        const Group g{.x0 = x0,
+                      .y = y,
+                      .r = r_,
+                      .d = d_,
+                      .channels = channels_,
+                      .weights = st.table.data() + size_t(y - tile.y0) * kTileSize +
+                                 size_t(x0 - tile.x0),
+                      .weightStride = planeStride(),
+                      .fu = &fu_};
+        accumulateSums(g, st.sums, st.groupWeights.data());
+        Lanes beta[kMaxGramSize * kMaxGramRhs];
+        solveLanes(st.sums, std::min(kLanes, width_ - x0), beta);
+        const size_t at = size_t(y - out.extent.y0) * accWidth + size_t(x0 - out.extent.x0);
+        accumulatePredictions(g, st.groupWeights.data(), beta, out.acc.data(), accWidth,
+                              accPlane, at);
+      }
   }
 
-  void regressPixel(const PixelRect& tile, int px, int py, ThreadState& st, TileResult& out) const {
-    const size_t area = planeStride(tile);
-    const float* w = st.table.data() + size_t(py - tile.y0) * size_t(tile.width()) +
-                     size_t(px - tile.x0);  // w_δ(p) = w[offsetIndex(δ) · planeStride]
-    float* cols = st.columns.data();
-    auto col = [&](int a) { return cols + size_t(a) * size_t(stride_); };
-    float* wRow = st.rowWeights.data();
-
-    // The window is the rectangle [qx0, qx1] × [qy0, qy1]; its pixels become consecutive rows
-    // of the design matrix, window row by window row. Rows with w = 0 stay: they add exactly 0.
-    float fp[kMaxGramSize];
-    for (int j = 0; j < m_; ++j) fp[j] = f_(px, py, j);
-    const int qx0 = std::max(0, px - r_), qx1 = std::min(width_ - 1, px + r_);
-    const int qy0 = std::max(0, py - r_), qy1 = std::min(height_ - 1, py + r_);
-    const int len = qx1 - qx0 + 1;
-    int n = 0;
-    for (int qy = qy0; qy <= qy1; ++qy, n += len) {
-      const float* wDy = w + size_t(offsetIndex(qx0 - px, qy - py)) * area;
-      for (int i = 0; i < len; ++i) {
-        wRow[n + i] = wDy[size_t(i) * area];
-        col(1)[n + i] = float(qx0 - px + i);
+  // β of every live lane from its sums (rank-revealing, in double); β = 0 for the others.
+  void solveLanes(const Lanes* sums, int live, Lanes* beta) const {
+    for (int e = 0; e < d_ * channels_; ++e) beta[e] = Lanes{};
+    for (int lane = 0; lane < live; ++lane) {
+      double gram[kMaxGramSize * kMaxGramSize], rhs[kMaxGramSize * kMaxGramRhs];
+      const Lanes* s = sums;
+      for (int a = 0; a < d_; ++a) {
+        for (int b = a; b < d_; ++b) gram[a * d_ + b] = (*s++)[lane];
+        for (int c = 0; c < channels_; ++c) rhs[a * channels_ + c] = (*s++)[lane];
       }
-      std::fill(col(2) + n, col(2) + n + len, float(qy - py));
-      const size_t rowStart = size_t(qy) * size_t(width_) + size_t(qx0);
-      for (int j = 0; j < m_; ++j) {
-        const float* src = f_.plane(j) + rowStart;
-        float* dst = col(3 + j) + n;
-        for (int i = 0; i < len; ++i) dst[i] = src[i] - fp[j];
-      }
-      for (int c = 0; c < channels_; ++c)
-        std::copy(u_.plane(c) + rowStart, u_.plane(c) + rowStart + len, col(d_ + c) + n);
-    }
-    const int padded = (n + kLanes - 1) / kLanes * kLanes;
-    for (int i = n; i < padded; ++i) {
-      wRow[i] = 0.0f;
-      for (int a = 1; a < d_ + channels_; ++a) col(a)[i] = 0.0f;
-    }
-    std::fill(col(0), col(0) + padded, 1.0f);
-
-    // Weighted Gram matrix and right-hand sides: G_ab = Σ w x_a x_b, B_ac = Σ w x_a u_c.
-    double gram[kMaxGramSize * kMaxGramSize] = {};
-    double rhs[kMaxGramSize * kMaxGramRhs] = {};
-    gramProducts(wRow, cols, padded, gram, rhs);
-    double beta[kMaxGramSize * kMaxGramRhs];
-    solveGramPivoted(gram, rhs, d_, channels_, beta, tol_);
-
-    // Predict every window pixel and accumulate it with its weight.
-    predict(beta, cols, padded, st.predictions.data());
-    const PixelRect& ext = out.extent;
-    const size_t extArea = size_t(ext.area());
-    for (int qy = qy0, i0 = 0; qy <= qy1; ++qy, i0 += len) {
-      const size_t at = size_t(qy - ext.y0) * size_t(ext.width()) + size_t(qx0 - ext.x0);
-      for (int c = 0; c < channels_; ++c) {
-        const float* pred = st.predictions.data() + size_t(c) * size_t(stride_) + i0;
-        float* __restrict acc = out.acc.data() + size_t(c) * extArea + at;
-        for (int i = 0; i < len; ++i) acc[i] += wRow[i0 + i] * pred[i];
-      }
-      float* __restrict wsum = out.wsum.data() + at;
-      for (int i = 0; i < len; ++i) wsum[i] += wRow[i0 + i];
-    }
-  }
-
-  // G (d × d, upper triangle) and B (d × C) from the window columns: each weighted column
-  // w · x_a is formed once per four-column block and shared by the four dot products.
-  void gramProducts(const float* w, const float* cols, int n, double* gram, double* rhs) const {
-    auto col = [&](int a) { return cols + size_t(a) * size_t(stride_); };
-    const int total = d_ + channels_;
-    for (int a = 0; a < d_; ++a) {
-      auto store = [&](int b, float v) {
-        if (b < d_)
-          gram[a * d_ + b] = v;
-        else
-          rhs[a * channels_ + (b - d_)] = v;
-      };
-      int b = a;
-      for (; b + 4 <= total; b += 4) {
-        float sums[4];
-        weightedDot4(w, col(a), col(b), col(b + 1), col(b + 2), col(b + 3), n, sums);
-        for (int k = 0; k < 4; ++k) store(b + k, sums[k]);
-      }
-      for (; b < total; ++b) store(b, weightedDot(w, col(a), col(b), n));
-    }
-  }
-
-  // Predictions x_qᵀ β for every window row, channel c into out + c · stride; each column is
-  // loaded once for all channels.
-  void predict(const double* beta, const float* cols, int n, float* out) const {
-    float b[kMaxGramSize][kMaxGramRhs];
-    for (int a = 0; a < d_; ++a)
-      for (int c = 0; c < channels_; ++c) b[a][c] = float(beta[a * channels_ + c]);
-    for (int i = 0; i < n; i += 4) {
-      Quad p[kMaxGramRhs];
-      for (int c = 0; c < channels_; ++c) p[c] = splatQuad(b[0][c]);
-      for (int a = 1; a < d_; ++a) {
-        const Quad xa = loadQuad(cols + size_t(a) * size_t(stride_) + size_t(i));
-        for (int c = 0; c < channels_; ++c) p[c] += splatQuad(b[a][c]) * xa;
-      }
-      for (int c = 0; c < channels_; ++c)
-        storeQuad(out + size_t(c) * size_t(stride_) + size_t(i), p[c]);
+      double solution[kMaxGramSize * kMaxGramRhs];
+      solveGramPivoted(gram, rhs, d_, channels_, solution, tol_);
+      for (int e = 0; e < d_ * channels_; ++e) beta[e][lane] = float(solution[e]);
     }
   }
 
@@ -245,37 +300,38 @@ class Regression {
     const int bands = (height_ + kTileSize - 1) / kTileSize;
     tbb::parallel_for(0, bands, [&](int band) {
       const PixelRect rows{0, band * kTileSize, width_, std::min(height_, (band + 1) * kTileSize)};
-      std::vector<float> acc(size_t(rows.area()) * size_t(channels_), 0.0f);
-      std::vector<float> wsum(size_t(rows.area()), 0.0f);
+      const size_t area = size_t(rows.area());
+      std::vector<float> acc(area * size_t(channels_ + 1), 0.0f);  // C planes, then wsum
       for (size_t t = 0; t < tiles.size(); ++t) {
         const TileResult& tr = results[t];
         const PixelRect overlap = tr.extent.intersect(rows);
-        for (int y = overlap.y0; y < overlap.y1; ++y)
-          for (int x = overlap.x0; x < overlap.x1; ++x) {
-            const size_t src =
-                size_t(y - tr.extent.y0) * size_t(tr.extent.width()) + size_t(x - tr.extent.x0);
-            const size_t dst = size_t(y - rows.y0) * size_t(width_) + size_t(x);
-            wsum[dst] += tr.wsum[src];
-            for (int c = 0; c < channels_; ++c)
-              acc[dst * size_t(channels_) + size_t(c)] +=
-                  tr.acc[size_t(c) * size_t(tr.extent.area()) + src];
+        const size_t trArea = size_t(tr.extent.area());
+        for (int c = 0; c <= channels_; ++c)
+          for (int y = overlap.y0; y < overlap.y1; ++y) {
+            const float* src = tr.acc.data() + size_t(c) * trArea +
+                               size_t(y - tr.extent.y0) * size_t(tr.extent.width()) +
+                               size_t(overlap.x0 - tr.extent.x0);
+            float* dst = acc.data() + size_t(c) * area + size_t(y - rows.y0) * size_t(width_) +
+                         size_t(overlap.x0);
+            for (int x = 0; x < overlap.width(); ++x) dst[x] += src[x];
           }
       }
+      const float* wsum = acc.data() + size_t(channels_) * area;
       for (int y = rows.y0; y < rows.y1; ++y)
         for (int x = 0; x < width_; ++x) {
           const size_t i = size_t(y - rows.y0) * size_t(width_) + size_t(x);
           for (int c = 0; c < channels_; ++c)
-            result(x, y, c) =
-                wsum[i] > 0.0f ? acc[i * size_t(channels_) + size_t(c)] / wsum[i] : u_(x, y, c);
+            result(x, y, c) = wsum[i] > 0.0f ? acc[size_t(c) * area + i] / wsum[i]
+                                             : fu_.row(m_ + c, y)[x];
         }
     });
     return result;
   }
 
-  PlanarImage u_, f_;
   const NlMeansWeights& weights_;
   GramTolerances tol_;
-  int width_, height_, r_, side_, channels_, m_, d_, stride_;
+  int width_, height_, r_, side_, channels_, m_, d_;
+  BorderedPlanes fu_;  // the features (non-finite → 0), then the data, with a zero border
 };
 
 }  // namespace

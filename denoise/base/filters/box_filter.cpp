@@ -3,7 +3,13 @@
 #include <algorithm>
 
 #include "denoise/image/planar_image.h"
-#include "denoise/base/filters/simd_quad.h"
+#include "denoise/util/simd_clones.h"
+
+// The row and column kernels are built for AVX-512F, AVX2 and the baseline (simd_clones.h),
+// without contraction into FMA, so that every build sums the same way (and the fused NL-means
+// weights, which share them, stay bit-identical to the general path). After the includes: GCC
+// does not inline across different optimisation options.
+#pragma GCC optimize("fp-contract=off")
 
 namespace chorus {
 namespace {
@@ -20,50 +26,58 @@ void inverseCounts(int n, int r, std::vector<float>& inv) {
 
 // Sums of 2R + 1 taps for one row: `padded` holds the row between R zeros on either side (adding
 // the zeros is exact, so clipped and interior pixels sum their taps the same way, in ascending
-// order); out[x] = sum · invCount[x], written four at a time (room for roundUp4(n) values).
+// order); out[x] = sum · invCount[x]. Plain loops: the vectoriser turns them into one pixel per
+// lane (the same sums in the same order at any vector width).
 template <int R>
-void boxRowDirect(const float* padded, float* out, int n, const float* invCount) {
-  for (int x = 0; x < n; x += 4) {
-    Quad acc = loadQuad(padded + x);
-    for (int j = 1; j <= 2 * R; ++j) acc += loadQuad(padded + x + j);
-    storeQuad(out + x, acc * loadQuad(invCount + x));
+[[gnu::always_inline]] inline void boxRowDirect(const float* __restrict padded,
+                                                float* __restrict out, int n,
+                                                const float* __restrict invCount) {
+  for (int x = 0; x < n; ++x) {
+    float acc = padded[x];
+    for (int j = 1; j <= 2 * R; ++j) acc += padded[x + j];
+    out[x] = acc * invCount[x];
   }
 }
 
-// out[x] = inv · Σ_{j < N} rows[j][x] for x < vectorEnd (a multiple of 4), rows in order.
+// out[x] = inv · Σ_{j < N} rows[j][x] for x < n, rows in order.
 template <int N>
-void columnSum(const float* const* rows, float inv, float* out, int vectorEnd) {
-  for (int x = 0; x < vectorEnd; x += 4) {
-    Quad acc = loadQuad(rows[0] + x);
-    for (int j = 1; j < N; ++j) acc += loadQuad(rows[j] + x);
-    storeQuad(out + x, acc * splatQuad(inv));
+[[gnu::always_inline]] inline void columnSum(const float* const* rows, float inv,
+                                             float* __restrict out, int n) {
+  const float* __restrict r[N];
+  for (int j = 0; j < N; ++j) r[j] = rows[j];
+  for (int x = 0; x < n; ++x) {
+    float acc = r[0][x];
+    for (int j = 1; j < N; ++j) acc += r[j][x];
+    out[x] = acc * inv;
   }
 }
 
-void columnSumAny(const float* const* rows, int n, float inv, float* out, int vectorEnd) {
+[[gnu::always_inline]] inline void columnSumAny(const float* const* rows, int n, float inv,
+                                                float* out, int width) {
   switch (n) {
     case 1:
-      return columnSum<1>(rows, inv, out, vectorEnd);
+      return columnSum<1>(rows, inv, out, width);
     case 2:
-      return columnSum<2>(rows, inv, out, vectorEnd);
+      return columnSum<2>(rows, inv, out, width);
     case 3:
-      return columnSum<3>(rows, inv, out, vectorEnd);
+      return columnSum<3>(rows, inv, out, width);
     case 4:
-      return columnSum<4>(rows, inv, out, vectorEnd);
+      return columnSum<4>(rows, inv, out, width);
     case 5:
-      return columnSum<5>(rows, inv, out, vectorEnd);
+      return columnSum<5>(rows, inv, out, width);
     case 6:
-      return columnSum<6>(rows, inv, out, vectorEnd);
+      return columnSum<6>(rows, inv, out, width);
     case 7:
-      return columnSum<7>(rows, inv, out, vectorEnd);
+      return columnSum<7>(rows, inv, out, width);
     case 8:
-      return columnSum<8>(rows, inv, out, vectorEnd);
+      return columnSum<8>(rows, inv, out, width);
     default:
-      return columnSum<9>(rows, inv, out, vectorEnd);
+      return columnSum<9>(rows, inv, out, width);
   }
 }
 
-void boxRowAny(const float* padded, float* out, int n, int r, const float* invCount) {
+[[gnu::always_inline]] inline void boxRowAny(const float* padded, float* out, int n, int r,
+                                             const float* invCount) {
   switch (r) {
     case 1:
       return boxRowDirect<1>(padded, out, n, invCount);
@@ -148,18 +162,14 @@ void boxFilterRunning(const float* src, float* dst, int width, int height, int r
 
 namespace box_kernels {
 
-void rowSums(const float* padded, float* out, int n, int r, const float* invCount) {
+CHORUS_SIMD_CLONES void rowSums(const float* padded, float* out, int n, int r,
+                                const float* invCount) {
   boxRowAny(padded, out, n, r, invCount);
 }
 
-void columnSums(const float* const* rows, int count, float inv, float* out, int n) {
-  const int vectorEnd = n / 4 * 4;
-  columnSumAny(rows, count, inv, out, vectorEnd);
-  for (int x = vectorEnd; x < n; ++x) {
-    float acc = rows[0][x];
-    for (int j = 1; j < count; ++j) acc += rows[j][x];
-    out[x] = acc * inv;
-  }
+CHORUS_SIMD_CLONES void columnSums(const float* const* rows, int count, float inv, float* out,
+                                   int n) {
+  columnSumAny(rows, count, inv, out, n);
 }
 
 }  // namespace box_kernels

@@ -6,8 +6,92 @@
 
 #include "denoise/base/filters/box_filter.h"
 #include "denoise/base/filters/fast_exp.h"
+#include "denoise/util/simd_clones.h"
+
+// The row kernels are built for AVX-512F, AVX2 and the baseline (simd_clones.h), without
+// contraction into FMA: every build gives the same bits. After the includes, and the kernels
+// use no std::min/max: GCC does not inline across different optimisation options.
+#pragma GCC optimize("fp-contract=off")
 
 namespace chorus {
+namespace {
+
+// The rows a pixel distance reads: guide g, α s V (n) and k² s Vd (d) at p, at p + δ (1) and,
+// for the symmetric distance, at p − δ (2).
+struct DistanceRows {
+  const float *gp, *np, *dp, *g1, *n1, *d1, *g2 = nullptr, *n2 = nullptr, *d2 = nullptr;
+};
+
+// d(p, p + δ) for w pixels (see nlmeans_weights.h), clamped; stored, or added to out. Values
+// w … wVector − 1 are written as 0 (whole vectors: the planes' margins make the reads safe).
+CHORUS_SIMD_CLONES void pairDistanceRow(const DistanceRows& rows, int w, int wVector, float eps,
+                                        float clamp, bool centerOnly, bool accumulate,
+                                        float* out) {
+  float* __restrict o = out;
+  const float* __restrict gp = rows.gp;
+  const float* __restrict np = rows.np;
+  const float* __restrict dp = rows.dp;
+  const float* __restrict g1 = rows.g1;
+  const float* __restrict n1 = rows.n1;
+  const float* __restrict d1 = rows.d1;
+  for (int x = 0; x < wVector; ++x) {
+    const float diff = gp[x] - g1[x];
+    const float num = diff * diff - (np[x] + (np[x] < n1[x] ? np[x] : n1[x]));
+    const float den = (centerOnly ? dp[x] + dp[x] : dp[x] + d1[x]) + eps;
+    float d = num / den;
+    d = d <= clamp ? d : clamp;  // also maps NaN (missing statistics) to the clamp
+    d = accumulate ? o[x] + d : d;
+    o[x] = x < w ? d : 0.0f;
+  }
+}
+
+// The distance from p to the mean of p + δ and p − δ; its variance is (V1 + V2) / 4.
+CHORUS_SIMD_CLONES void symmetricDistanceRow(const DistanceRows& rows, int w, float eps,
+                                             float clamp, bool centerOnly, bool accumulate,
+                                             float* out) {
+  float* __restrict o = out;
+  const float* __restrict gp = rows.gp;
+  const float* __restrict np = rows.np;
+  const float* __restrict dp = rows.dp;
+  const float* __restrict g1 = rows.g1;
+  const float* __restrict n1 = rows.n1;
+  const float* __restrict d1 = rows.d1;
+  const float* __restrict g2 = rows.g2;
+  const float* __restrict n2 = rows.n2;
+  const float* __restrict d2 = rows.d2;
+  for (int x = 0; x < w; ++x) {
+    const float diff = gp[x] - 0.5f * (g1[x] + g2[x]);
+    const float min1 = np[x] < n1[x] ? np[x] : n1[x], min2 = np[x] < n2[x] ? np[x] : n2[x];
+    const float num = diff * diff - (np[x] + 0.25f * (min1 + min2));
+    const float den = (centerOnly ? dp[x] + dp[x] : dp[x] + 0.25f * (d1[x] + d2[x])) + eps;
+    float d = num / den;
+    d = d <= clamp ? d : clamp;
+    o[x] = accumulate ? o[x] + d : d;
+  }
+}
+
+// m = max(m, d) over n values (MinOverChannels: min_c exp(−max(0, D_c)) = exp(−max(0, max_c D_c))).
+CHORUS_SIMD_CLONES void maxRow(float* m, const float* d, int n) {
+  float* __restrict a = m;
+  const float* __restrict b = d;
+  for (int x = 0; x < n; ++x) a[x] = a[x] < b[x] ? b[x] : a[x];
+}
+
+// w = exp(−max(0, D)) over n values (D clamped to kMaxExpArgument first), then 0 below
+// `threshold`. Separate loops, so that each vectorises.
+CHORUS_SIMD_CLONES void weightRow(const float* distance, int n, float threshold, float* weights) {
+  const float* __restrict d = distance;
+  float* __restrict w = weights;
+  for (int x = 0; x < n; ++x) {
+    const float v = d[x] < 0.0f ? 0.0f : d[x];  // as std::min(std::max(d, 0), kMax)
+    w[x] = -(kMaxExpArgument < v ? kMaxExpArgument : v);
+  }
+  expNonPositiveInPlace(w, size_t(n));
+  for (int x = 0; x < n; ++x) w[x] = w[x] < threshold ? 0.0f : w[x];
+}
+
+}  // namespace
+
 NlMeansWeights::NlMeansWeights(std::span<const NlMeansTerm> terms, const NlMeansParams& params)
     : params_(params) {
   if (terms.empty()) throw std::invalid_argument("NlMeansWeights: no terms");
@@ -42,26 +126,29 @@ NlMeansWeights::NlMeansWeights(std::span<const NlMeansTerm> terms, const NlMeans
     t.refineMinWeight = std::isfinite(term.symmetricDistanceLimit)
                             ? std::exp(-std::max(0.0f, term.symmetricDistanceLimit))
                             : 0.0f;
-    t.guide = PlanarImage(g);
-    t.varianceNum = PlanarImage(v);
-    t.varianceDen = PlanarImage(vd);
+    const int C = g.channels();
+    t.guideChannels = C;
+    t.planes = PaddedPlanes(width_, height_, 3 * C, kRowVector);
     const float numScale = term.alpha * term.s, denScale = term.k * term.k * term.s;
-    const size_t n = t.guide.pixelCount();
-    for (int c = 0; c < g.channels(); ++c) {
-      float* gp = t.guide.plane(c);
-      float* vn = t.varianceNum.plane(c);
-      float* vdp = t.varianceDen.plane(c);
-      for (size_t i = 0; i < n; ++i) {
-        // Missing statistics: the pixel matches nothing (its distance becomes the clamp).
-        if (!std::isfinite(gp[i]) || !std::isfinite(vn[i]) || !std::isfinite(vdp[i])) {
-          gp[i] = std::numeric_limits<float>::quiet_NaN();
-          vn[i] = vdp[i] = 0.0f;
-          continue;
+    for (int c = 0; c < C; ++c)
+      for (int y = 0; y < height_; ++y) {
+        float* gp = t.planes.plane(c) + t.planes.index(0, y);
+        float* vn = t.planes.plane(C + c) + t.planes.index(0, y);
+        float* vdp = t.planes.plane(2 * C + c) + t.planes.index(0, y);
+        for (int x = 0; x < width_; ++x) {
+          gp[x] = g(x, y, c);
+          vn[x] = v(x, y, c);
+          vdp[x] = vd(x, y, c);
+          // Missing statistics: the pixel matches nothing (its distance becomes the clamp).
+          if (!std::isfinite(gp[x]) || !std::isfinite(vn[x]) || !std::isfinite(vdp[x])) {
+            gp[x] = std::numeric_limits<float>::quiet_NaN();
+            vn[x] = vdp[x] = 0.0f;
+            continue;
+          }
+          vn[x] = std::max(0.0f, vn[x]) * numScale;
+          vdp[x] = std::max(0.0f, vdp[x]) * denScale;
         }
-        vn[i] = std::max(0.0f, vn[i]) * numScale;
-        vdp[i] = std::max(0.0f, vdp[i]) * denScale;
       }
-    }
     anySymmetric_ = anySymmetric_ || t.symmetric;
     terms_.push_back(std::move(t));
   }
@@ -72,53 +159,36 @@ NlMeansWeights::NlMeansWeights(std::span<const NlMeansTerm> terms, const NlMeans
 
 int NlMeansWeights::distanceChannels(int term) const {
   const PreparedTerm& t = terms_.at(size_t(term));
-  return t.channels == ChannelWeights::AverageDistance ? 1 : t.guide.channels();
+  return t.channels == ChannelWeights::AverageDistance ? 1 : t.guideChannels;
 }
 
-void NlMeansWeights::distanceRow(const PreparedTerm& t, int c, int y, int x0, int w, int dx, int dy,
-                                 bool accumulate, bool symmetric, float* out) {
-  const float eps = t.epsilon, clamp = t.distanceClamp;
-  const bool centerOnly = t.centerOnlyDenominator;
-  float* __restrict o = out;
-  const float* __restrict gp = t.guide.row(c, y) + x0;
-  const float* __restrict np = t.varianceNum.row(c, y) + x0;
-  const float* __restrict dp = t.varianceDen.row(c, y) + x0;
-  const float* __restrict g1 = t.guide.row(c, y + dy) + x0 + dx;
-  const float* __restrict n1 = t.varianceNum.row(c, y + dy) + x0 + dx;
-  const float* __restrict d1 = t.varianceDen.row(c, y + dy) + x0 + dx;
+void NlMeansWeights::distanceRow(const PreparedTerm& t, int c, int y, int x0, int w, int wVector,
+                                 int dx, int dy, bool accumulate, bool symmetric, float* out) {
+  DistanceRows rows{.gp = t.guideRow(c, y) + x0,
+                    .np = t.numRow(c, y) + x0,
+                    .dp = t.denRow(c, y) + x0,
+                    .g1 = t.guideRow(c, y + dy) + x0 + dx,
+                    .n1 = t.numRow(c, y + dy) + x0 + dx,
+                    .d1 = t.denRow(c, y + dy) + x0 + dx};
   if (!symmetric) {
-    for (int x = 0; x < w; ++x) {
-      const float diff = gp[x] - g1[x];
-      const float num = diff * diff - (np[x] + std::min(np[x], n1[x]));
-      const float den = (centerOnly ? dp[x] + dp[x] : dp[x] + d1[x]) + eps;
-      float d = num / den;
-      d = d <= clamp ? d : clamp;  // also maps NaN (missing statistics) to the clamp
-      o[x] = accumulate ? o[x] + d : d;
-    }
+    pairDistanceRow(rows, w, wVector, t.epsilon, t.distanceClamp, t.centerOnlyDenominator,
+                    accumulate, out);
     return;
   }
-  const float* __restrict g2 = t.guide.row(c, y - dy) + x0 - dx;
-  const float* __restrict n2 = t.varianceNum.row(c, y - dy) + x0 - dx;
-  const float* __restrict d2 = t.varianceDen.row(c, y - dy) + x0 - dx;
-  for (int x = 0; x < w; ++x) {
-    // Distance from p to the mean of its two neighbours; its variance is (V1 + V2) / 4.
-    const float diff = gp[x] - 0.5f * (g1[x] + g2[x]);
-    const float num =
-        diff * diff - (np[x] + 0.25f * (std::min(np[x], n1[x]) + std::min(np[x], n2[x])));
-    const float den = (centerOnly ? dp[x] + dp[x] : dp[x] + 0.25f * (d1[x] + d2[x])) + eps;
-    float d = num / den;
-    d = d <= clamp ? d : clamp;
-    o[x] = accumulate ? o[x] + d : d;
-  }
+  rows.g2 = t.guideRow(c, y - dy) + x0 - dx;
+  rows.n2 = t.numRow(c, y - dy) + x0 - dx;
+  rows.d2 = t.denRow(c, y - dy) + x0 - dx;
+  symmetricDistanceRow(rows, w, t.epsilon, t.distanceClamp, t.centerOnlyDenominator, accumulate,
+                       out);
 }
 
 void NlMeansWeights::pixelDistances(const PreparedTerm& t, const PixelRect& e, int dx, int dy,
                                     bool average, bool symmetric, float* out) const {
-  const int w = e.width(), channels = t.guide.channels();
+  const int w = e.width(), channels = t.guideChannels;
   const size_t area = size_t(e.area());
   for (int c = 0; c < channels; ++c)
     for (int y = e.y0; y < e.y1; ++y)
-      distanceRow(t, c, y, e.x0, w, dx, dy, average && c > 0, symmetric,
+      distanceRow(t, c, y, e.x0, w, w, dx, dy, average && c > 0, symmetric,
                   out + (average ? 0 : size_t(c) * area) + size_t(y - e.y0) * size_t(w));
   if (average && channels > 1) {
     const float inv = 1.0f / float(channels);
@@ -135,7 +205,7 @@ void NlMeansWeights::termPatchDistance(const PreparedTerm& t, const PixelRect& r
                     .intersect(neighbourInside(width_, height_, dx, dy));
   if (symmetric) e = e.intersect(neighbourInside(width_, height_, -dx, -dy));
   const bool average = t.channels == ChannelWeights::AverageDistance;
-  const int planes = average ? 1 : t.guide.channels();
+  const int planes = average ? 1 : t.guideChannels;
   const size_t eArea = size_t(e.area());
   scratch.pixelDistance.resize(eArea * size_t(planes));
   pixelDistances(t, e, dx, dy, average, symmetric, scratch.pixelDistance.data());
@@ -168,7 +238,7 @@ void NlMeansWeights::termWeights(const PreparedTerm& t, const float* distance, s
                                  float* out) const {
   // First −min(max(0, D), kMaxExpArgument) (weights are exp of it), then the exponential, in
   // separate loops so that both vectorise.
-  const int channels = t.guide.channels();
+  const int channels = t.guideChannels;
   switch (t.channels) {
     case ChannelWeights::PerChannel:
       for (size_t i = 0; i < area * size_t(channels); ++i)
@@ -213,10 +283,10 @@ void NlMeansWeights::combinedWeights(const PixelRect& region, int dx, int dy,
   const size_t area = size_t(region.area());
   std::fill(out, out + area * size_t(weightChannels_), 1.0f);
   for (const PreparedTerm& t : terms_) {
-    const int planes = t.channels == ChannelWeights::AverageDistance ? 1 : t.guide.channels();
+    const int planes = t.channels == ChannelWeights::AverageDistance ? 1 : t.guideChannels;
     scratch.patchDistance.resize(area * size_t(planes));
     termPatchDistance(t, region, dx, dy, false, scratch, scratch.patchDistance.data());
-    const int wPlanes = termWeightChannels(t.channels, t.guide.channels());
+    const int wPlanes = termWeightChannels(t.channels, t.guideChannels);
     scratch.termPlus.resize(area * size_t(wPlanes));
     termWeights(t, scratch.patchDistance.data(), area, scratch.termPlus.data());
     minInto(out, weightChannels_, scratch.termPlus.data(), wPlanes, area);
@@ -256,23 +326,28 @@ void NlMeansWeights::fusedOffsetWeights(const PreparedTerm& t, const PixelRect& 
   if (r.empty()) return;
   const PixelRect e = r.grown(t.f).intersect(valid);
   const bool average = t.channels == ChannelWeights::AverageDistance;
-  const int channels = t.guide.channels(), planes = average ? 1 : channels, f = t.f;
+  const int channels = t.guideChannels, planes = average ? 1 : channels, f = t.f;
   const int ring = 2 * f + 1, rw = r.width(), ew = e.width();
   const size_t stride = size_t(box_kernels::roundUp4(rw));
-  const size_t paddedSize = size_t(box_kernels::roundUp4(rw + 2 * f) + 4);
+  // The distances of a row go straight into a zero-padded row (pixel x at x − (r.x0 − f)), one
+  // per plane, in whole vectors (the planes' margins make the reads safe); the row sums read
+  // them only once every plane's row is written, so the stores have left the store buffer.
+  const int lead = e.x0 - (r.x0 - f);  // zeros left of e
+  const int ewVector = (ew + kRowVector - 1) / kRowVector * kRowVector;
+  const size_t paddedSize =
+      std::max(size_t(lead + ewVector), size_t(box_kernels::roundUp4(rw + 2 * f) + 4));
 
-  // Scratch: one row of pixel distances, a zero-padded row, the row means of the last 2f + 1
-  // rows (a ring), one row of patch distances and the inverse counts of both axes.
+  // Scratch: the zero-padded distance rows, the row means of the last 2f + 1 rows (a ring), one
+  // row of patch distances and the inverse counts of both axes.
   std::vector<float>& buf = scratch.pixelDistance;
-  buf.resize(size_t(planes) * size_t(ew) + paddedSize +
-             (size_t(ring) + 1) * size_t(planes) * stride + stride + size_t(e.height()));
-  float* rowDistance = buf.data();
-  float* padded = rowDistance + size_t(planes) * size_t(ew);
-  float* ringRows = padded + paddedSize;
+  buf.resize(size_t(planes) * paddedSize + (size_t(ring) + 1) * size_t(planes) * stride + stride +
+             size_t(e.height()));
+  float* padded = buf.data();
+  float* ringRows = padded + size_t(planes) * paddedSize;
   float* patch = ringRows + size_t(ring) * size_t(planes) * stride;
   float* invX = patch + size_t(planes) * stride;
   float* invY = invX + stride;
-  std::fill(padded, padded + paddedSize, 0.0f);
+  std::fill(padded, padded + size_t(planes) * paddedSize, 0.0f);
   for (int x = 0; x < rw; ++x) {
     const int px = r.x0 - e.x0 + x;
     invX[x] = 1.0f / float(std::min(ew - 1, px + f) - std::max(0, px - f) + 1);
@@ -283,7 +358,6 @@ void NlMeansWeights::fusedOffsetWeights(const PreparedTerm& t, const PixelRect& 
   auto ringRow = [&](int y, int c) {
     return ringRows + (size_t((y - e.y0) % ring) * size_t(planes) + size_t(c)) * stride;
   };
-  const int copyBegin = std::max(e.x0, r.x0 - f), copyEnd = std::min(e.x1, r.x1 + f);
 
   // One output row of weights from the ring rows [yo − f, yo + f] ∩ e.
   const float threshold = params_.weightThreshold;
@@ -300,43 +374,29 @@ void NlMeansWeights::fusedOffsetWeights(const PreparedTerm& t, const PixelRect& 
       box_kernels::columnSums(rows, b - a + 1, invY[yo - e.y0], dst, rw);
     }
     float* row = out + size_t(yo - tile.y0) * size_t(tile.width()) + size_t(r.x0 - tile.x0);
-    auto finish = [&](float* w, int n) {
-      expNonPositiveInPlace(w, size_t(n));
-      for (int x = 0; x < n; ++x) w[x] = w[x] < threshold ? 0.0f : w[x];
-    };
     if (t.channels == ChannelWeights::PerChannel) {
-      for (int c = 0; c < planes; ++c) {
-        float* w = row + size_t(c) * tArea;
-        const float* d = patch + size_t(c) * stride;
-        for (int x = 0; x < rw; ++x) w[x] = -std::min(std::max(d[x], 0.0f), kMaxExpArgument);
-        finish(w, rw);
-      }
+      for (int c = 0; c < planes; ++c)
+        weightRow(patch + size_t(c) * stride, rw, threshold, row + size_t(c) * tArea);
       return;
     }
-    float* m = patch;  // MinOverChannels: max_c D_c, in channel order
-    for (int c = 1; c < planes; ++c)
-      for (int x = 0; x < rw; ++x) m[x] = std::max(m[x], patch[size_t(c) * stride + size_t(x)]);
-    for (int x = 0; x < rw; ++x) row[x] = -std::min(std::max(m[x], 0.0f), kMaxExpArgument);
-    finish(row, rw);
+    for (int c = 1; c < planes; ++c) maxRow(patch, patch + size_t(c) * stride, rw);
+    weightRow(patch, rw, threshold, row);
   };
 
   for (int y = e.y0; y < e.y1; ++y) {
     for (int c = 0; c < channels; ++c)
-      distanceRow(t, c, y, e.x0, ew, dx, dy, average && c > 0, false,
-                  rowDistance + (average ? 0 : size_t(c) * size_t(ew)));
+      distanceRow(t, c, y, e.x0, ew, ewVector, dx, dy, average && c > 0, false,
+                  padded + (average ? 0 : size_t(c) * paddedSize) + lead);
     if (average && channels > 1) {
       const float inv = 1.0f / float(channels);
-      for (int x = 0; x < ew; ++x) rowDistance[x] *= inv;
+      for (int x = lead; x < lead + ew; ++x) padded[x] *= inv;
     }
     for (int c = 0; c < planes; ++c) {
-      const float* src = rowDistance + size_t(c) * size_t(ew);
-      if (f == 0) {
-        std::copy(src + (r.x0 - e.x0), src + (r.x0 - e.x0) + rw, ringRow(y, c));
-        continue;
-      }
-      std::copy(src + (copyBegin - e.x0), src + (copyEnd - e.x0),
-                padded + (copyBegin - (r.x0 - f)));
-      box_kernels::rowSums(padded, ringRow(y, c), rw, f, invX);
+      const float* src = padded + size_t(c) * paddedSize;
+      if (f == 0)
+        std::copy(src, src + rw, ringRow(y, c));
+      else
+        box_kernels::rowSums(src, ringRow(y, c), rw, f, invX);
     }
     const int yo = y - f;
     if (yo >= r.y0 && yo < r.y1) emit(yo);
@@ -361,8 +421,8 @@ void NlMeansWeights::offsetPair(const PixelRect& tile, int dx, int dy, NlMeansSc
   scratch.minus.assign(mArea * size_t(wch), 1.0f);
 
   for (const PreparedTerm& t : terms_) {
-    const int planes = t.channels == ChannelWeights::AverageDistance ? 1 : t.guide.channels();
-    const int wPlanes = termWeightChannels(t.channels, t.guide.channels());
+    const int planes = t.channels == ChannelWeights::AverageDistance ? 1 : t.guideChannels;
+    const int wPlanes = termWeightChannels(t.channels, t.guideChannels);
     scratch.patchDistance.resize(std::max(pArea, mArea) * size_t(planes));
     scratch.termPlus.resize(pArea * size_t(wPlanes));
     scratch.termMinus.resize(mArea * size_t(wPlanes));

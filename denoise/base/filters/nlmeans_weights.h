@@ -27,8 +27,8 @@
 #include <vector>
 
 #include "denoise/base/filters/pixel_rect.h"
-#include "denoise/image/planar_image.h"
 #include "denoise/image/image.h"
+#include "denoise/image/padded_planes.h"
 
 namespace chorus {
 
@@ -60,6 +60,11 @@ struct NlMeansTerm {
   bool symmetricRefinement = false;
   float symmetricDistanceLimit = std::numeric_limits<float>::infinity();
 };
+
+// Row kernels process whole vectors of this many pixels where their buffers allow: an AVX2
+// vector, so that a row of an AVX-512 build ends in at most one half-width vector and no
+// scalar tail (divisions bound these kernels; padding further only adds divisions).
+inline constexpr int kRowVector = 8;
 
 // The centre weight w(p, p).
 enum class CenterWeight {
@@ -109,9 +114,10 @@ class NlMeansWeights {
       for (int dx = dy == 0 ? 1 : -params_.r; dx <= params_.r; ++dx) fn(dx, dy);
   }
 
-  // w_δ(p) into `plus` and w_−δ(p) into `minus` for every p of `tile` (inside the image), δ ≠ 0.
-  // Layout: weightChannels() planes of tile.area() values, row-major within the tile. The
-  // weight is 0 where p + δ (resp. p − δ) is outside the image.
+  // w_δ(p) into `plus` and w_−δ(p) into `minus` for every p of `tile`, δ ≠ 0. Layout:
+  // weightChannels() planes of tile.area() values, row-major within the tile. The weight is 0
+  // where p + δ (resp. p − δ) is outside the image, and where p is (the tile may extend past
+  // the image).
   void offsetPair(const PixelRect& tile, int dx, int dy, NlMeansScratch& scratch, float* plus,
                   float* minus) const;
 
@@ -142,15 +148,22 @@ class NlMeansWeights {
     float epsilon = 0, distanceClamp = 0;
     bool centerOnlyDenominator = false, symmetric = false;
     float refineMinWeight = 0;  // exp(−symmetricDistanceLimit)
-    PlanarImage guide;          // g; NaN where g, V or Vd is not finite
-    PlanarImage varianceNum;    // α s V
-    PlanarImage varianceDen;    // k² s Vd
+    int guideChannels = 0;
+    // Planes c: g (NaN where g, V or Vd is not finite); C + c: α s V; 2C + c: k² s Vd. Rows
+    // have a margin of kRowVector zeros, so that row kernels may run kRowVector − 1 pixels
+    // past a row's end.
+    PaddedPlanes planes;
+    const float* guideRow(int c, int y) const { return row(c, y); }
+    const float* numRow(int c, int y) const { return row(guideChannels + c, y); }
+    const float* denRow(int c, int y) const { return row(2 * guideChannels + c, y); }
+    const float* row(int plane, int y) const { return planes.plane(plane) + planes.index(0, y); }
   };
 
   // Per-pixel distances d_c of one row segment [x0, x0 + w) × {y} (stored, or added to `out`
-  // when `accumulate`). With `symmetric`, the distance to the mean of p + δ and p − δ.
-  static void distanceRow(const PreparedTerm& t, int c, int y, int x0, int w, int dx, int dy,
-                          bool accumulate, bool symmetric, float* out);
+  // when `accumulate`), then zeros up to wVector ≥ w. With `symmetric`, the distance to the
+  // mean of p + δ and p − δ.
+  static void distanceRow(const PreparedTerm& t, int c, int y, int x0, int w, int wVector, int dx,
+                          int dy, bool accumulate, bool symmetric, float* out);
   // Per-pixel distances of term t over rect e for offset (dx, dy): one plane per channel, or
   // their mean when `average`.
   void pixelDistances(const PreparedTerm& t, const PixelRect& e, int dx, int dy, bool average,

@@ -10,7 +10,9 @@ int solveGramPivoted(const double* G, const double* B, int d, int C, double* bet
                      const GramTolerances& tol) {
   if (d > kMaxGramSize || C > kMaxGramRhs || d < 0 || C < 0)
     throw std::invalid_argument("solveGramPivoted: problem too large");
-  double a[kMaxGramSize][kMaxGramSize];  // scaled Gram, factorised in place (lower part = L)
+  // Scaled Gram, factorised in place. Only the lower triangle (i ≥ j) is stored and read: the
+  // trailing Schur complement, and left of it the columns of L.
+  double a[kMaxGramSize][kMaxGramSize];
   double rhs[kMaxGramSize][kMaxGramRhs];
   double scale[kMaxGramSize];
   int perm[kMaxGramSize];
@@ -24,7 +26,7 @@ int solveGramPivoted(const double* G, const double* B, int d, int C, double* bet
     perm[j] = j;
   }
   for (int i = 0; i < d; ++i) {
-    for (int j = i; j < d; ++j) a[i][j] = a[j][i] = G[i * d + j] * scale[i] * scale[j];
+    for (int j = 0; j <= i; ++j) a[i][j] = G[j * d + i] * scale[j] * scale[i];
     for (int c = 0; c < C; ++c) rhs[i][c] = B[i * C + c] * scale[i];
   }
 
@@ -36,19 +38,19 @@ int solveGramPivoted(const double* G, const double* B, int d, int C, double* bet
       if (a[j][j] > a[best][best]) best = j;
     if (!(a[best][best] > tol.relativePivotTolerance)) break;
     if (best != k) {
+      // Symmetric swap of k and best in lower-triangle storage.
       std::swap(perm[k], perm[best]);
-      for (int j = 0; j < d; ++j) std::swap(a[k][j], a[best][j]);
-      for (int j = 0; j < d; ++j) std::swap(a[j][k], a[j][best]);
+      for (int j = 0; j < k; ++j) std::swap(a[k][j], a[best][j]);
+      std::swap(a[k][k], a[best][best]);
+      for (int i = k + 1; i < best; ++i) std::swap(a[i][k], a[best][i]);
+      for (int i = best + 1; i < d; ++i) std::swap(a[i][k], a[i][best]);
       for (int c = 0; c < C; ++c) std::swap(rhs[k][c], rhs[best][c]);
     }
     const double lkk = std::sqrt(a[k][k]);
     a[k][k] = lkk;
     for (int i = k + 1; i < d; ++i) a[i][k] /= lkk;
     for (int i = k + 1; i < d; ++i)
-      for (int j = k + 1; j <= i; ++j) {
-        a[i][j] -= a[i][k] * a[j][k];
-        a[j][i] = a[i][j];
-      }
+      for (int j = k + 1; j <= i; ++j) a[i][j] -= a[i][k] * a[j][k];
     rank = k + 1;
   }
 

@@ -7,6 +7,12 @@
 #include <stdexcept>
 
 #include "denoise/image/planar_image.h"
+#include "denoise/util/simd_clones.h"
+
+// The accumulation kernel is built for AVX-512F, AVX2 and the baseline (simd_clones.h), without
+// contraction into FMA, so that every build gives the same bits. After the includes: GCC does
+// not inline across different optimisation options.
+#pragma GCC optimize("fp-contract=off")
 
 namespace chorus {
 namespace {
@@ -27,6 +33,21 @@ struct TileBuffers {
   std::vector<std::vector<float>> acc;  // per data image: channels planes of the tile
 };
 
+// sum[x] += w[x] for x < n.
+CHORUS_SIMD_CLONES void addRow(float* sum, const float* w, int n) {
+  float* __restrict s = sum;
+  const float* __restrict wr = w;
+  for (int x = 0; x < n; ++x) s[x] += wr[x];
+}
+
+// acc[x] += w[x] · src[x] for x < n.
+CHORUS_SIMD_CLONES void addProductRow(float* acc, const float* w, const float* src, int n) {
+  float* __restrict a = acc;
+  const float* __restrict wr = w;
+  const float* __restrict sr = src;
+  for (int x = 0; x < n; ++x) a[x] += wr[x] * sr[x];
+}
+
 // acc += w · u(p + δ) and wsum += w for the pixels p of the tile whose neighbour is `valid`.
 void accumulate(const PixelRect& tile, const PixelRect& valid, int dx, int dy, const float* w,
                 int weightChannels, const std::vector<PlanarImage>& data, TileBuffers& buf,
@@ -41,7 +62,7 @@ void accumulate(const PixelRect& tile, const PixelRect& valid, int dx, int dy, c
     for (int y = inside.y0; y < inside.y1; ++y) {
       const size_t begin = size_t(y - tile.y0) * size_t(tw) + size_t(inside.x0 - tile.x0);
       const size_t end = begin + size_t(inside.width());
-      for (size_t i = begin; i < end; ++i) sum[i] += wPlane[i];
+      addRow(sum + begin, wPlane + begin, inside.width());
       if (trackMax)
         for (size_t i = begin; i < end; ++i) maxW[i] = std::max(maxW[i], wPlane[i]);
     }
@@ -53,10 +74,8 @@ void accumulate(const PixelRect& tile, const PixelRect& valid, int dx, int dy, c
       float* acc = buf.acc[d].data() + size_t(c) * tArea;
       for (int y = inside.y0; y < inside.y1; ++y) {
         const size_t rowOffset = size_t(y - tile.y0) * size_t(tw);
-        const float* __restrict src = u.row(c, y + dy) + dx + inside.x0;
-        const float* __restrict wr = wPlane + rowOffset + size_t(inside.x0 - tile.x0);
-        float* __restrict ar = acc + rowOffset + size_t(inside.x0 - tile.x0);
-        for (int x = 0; x < inside.width(); ++x) ar[x] += wr[x] * src[x];
+        const size_t at = rowOffset + size_t(inside.x0 - tile.x0);
+        addProductRow(acc + at, wPlane + at, u.row(c, y + dy) + dx + inside.x0, inside.width());
       }
     }
   }

@@ -319,10 +319,26 @@ void NlMeansWeights::finishWeights(float* weights, const PixelRect& region, cons
 void NlMeansWeights::fusedOffsetWeights(const PreparedTerm& t, const PixelRect& tile, int dx,
                                         int dy, NlMeansScratch& scratch, float* out) const {
   const size_t tArea = size_t(tile.area());
-  std::fill(out, out + tArea * size_t(weightChannels_), 0.0f);
   const PixelRect valid =
       PixelRect::image(width_, height_).intersect(neighbourInside(width_, height_, dx, dy));
   const PixelRect r = tile.intersect(valid);
+  // Weight 0 where the neighbour (or p) is outside the image: the tile minus r.
+  const size_t tw = size_t(tile.width());
+  for (int c = 0; c < weightChannels_; ++c) {
+    float* plane = out + size_t(c) * tArea;
+    if (r.empty()) {
+      std::fill(plane, plane + tArea, 0.0f);
+      continue;
+    }
+    std::fill(plane, plane + size_t(r.y0 - tile.y0) * tw, 0.0f);
+    std::fill(plane + size_t(r.y1 - tile.y0) * tw, plane + tArea, 0.0f);
+    if (r.x0 == tile.x0 && r.x1 == tile.x1) continue;
+    for (int y = r.y0; y < r.y1; ++y) {
+      float* row = plane + size_t(y - tile.y0) * tw;
+      std::fill(row, row + (r.x0 - tile.x0), 0.0f);
+      std::fill(row + (r.x1 - tile.x0), row + tw, 0.0f);
+    }
+  }
   if (r.empty()) return;
   const PixelRect e = r.grown(t.f).intersect(valid);
   const bool average = t.channels == ChannelWeights::AverageDistance;
@@ -348,13 +364,16 @@ void NlMeansWeights::fusedOffsetWeights(const PreparedTerm& t, const PixelRect& 
   float* invX = patch + size_t(planes) * stride;
   float* invY = invX + stride;
   std::fill(padded, padded + size_t(planes) * paddedSize, 0.0f);
+  // 1 / (true count) of the clipped box: a count is at most 2f + 1, so a table of those.
+  float inverse[2 * box_kernels::kMaxDirectRadius + 2];
+  for (int k = 1; k <= 2 * f + 1; ++k) inverse[k] = 1.0f / float(k);
   for (int x = 0; x < rw; ++x) {
     const int px = r.x0 - e.x0 + x;
-    invX[x] = 1.0f / float(std::min(ew - 1, px + f) - std::max(0, px - f) + 1);
+    invX[x] = inverse[std::min(ew - 1, px + f) - std::max(0, px - f) + 1];
   }
   for (int x = rw; x < int(stride); ++x) invX[x] = 0.0f;
   for (int y = 0; y < e.height(); ++y)
-    invY[y] = 1.0f / float(std::min(e.height() - 1, y + f) - std::max(0, y - f) + 1);
+    invY[y] = inverse[std::min(e.height() - 1, y + f) - std::max(0, y - f) + 1];
   auto ringRow = [&](int y, int c) {
     return ringRows + (size_t((y - e.y0) % ring) * size_t(planes) + size_t(c)) * stride;
   };

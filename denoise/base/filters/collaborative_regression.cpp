@@ -90,14 +90,21 @@ inline const float* offsetWeights(const Group& g, int dx, int dy) {
 // from the group at run time.
 constexpr int kNforColumns = 11, kNforChannels = 3;  // NFOR: 8 features, RGB
 
+// Index of the sum of columns a ≤ b in the layout of kMaxSums (total = d + C columns).
+constexpr int sumIndex(int total, int a, int b) {
+  return a * total - a * (a - 1) / 2 + (b - a);
+}
+
 // sums (see kMaxSums) = Σ_δ w_δ · x_a · x_b for every centre of the group. Each window row is
-// summed on its own first and then added (two-level summation: shorter float sums). The
-// weights are also copied to `groupWeights` (w_δ at offsetIndex(δ) · kLanes) for the
-// predictions: the table's planes are far apart, and this way it is read only once.
+// summed on its own first and then added (two-level summation: shorter float sums). Column 2
+// is dy, constant along a window row, so its sums are dy times the row's sums with column 0
+// (Σ w dy x_b = dy Σ w x_b), formed once per row instead of at every offset. The weights are
+// also copied to `groupWeights` (w_δ at offsetIndex(δ) · kLanes) for the predictions: the
+// table's planes are far apart, and this way it is read only once.
 template <int kD, int kC>
 [[gnu::always_inline]] inline void accumulateSumsOf(const Group& g, Lanes* sums,
                                                     float* groupWeights) {
-  const int d = kD ? kD : g.d, C = kD ? kC : g.channels;
+  const int d = kD ? kD : g.d, C = kD ? kC : g.channels, total = d + C;
   const int count = d * (d + 1) / 2 + d * C;
   Lanes fp[kMaxGramSize], x[kMaxColumns], rowSums[kMaxSums];
   centreFeatures(g, d, fp);
@@ -113,21 +120,28 @@ template <int kD, int kC>
       groupWeights += kLanes;
       designRow(g, d, C, fp, dx, dy, x);
       if constexpr (kD > 0) {
-        int e = 0;
 #pragma GCC unroll 32
         for (int a = 0; a < kD; ++a) {
+          if (a == 2) continue;
           const Lanes wa = w * x[a];
 #pragma GCC unroll 32
-          for (int b = a; b < kD + kC; ++b) rowSums[e++] += wa * x[b];
+          for (int b = a; b < kD + kC; ++b)
+            if (b != 2) rowSums[sumIndex(kD + kC, a, b)] += wa * x[b];
         }
       } else {
-        Lanes* s = rowSums;
         for (int a = 0; a < d; ++a) {
+          if (a == 2) continue;
           const Lanes wa = w * x[a];
-          for (int b = a; b < d + C; ++b) *s++ += wa * x[b];
+          for (int b = a; b < total; ++b)
+            if (b != 2) rowSums[sumIndex(total, a, b)] += wa * x[b];
         }
       }
     }
+    const Lanes rowDy = splat(float(dy));
+    rowSums[sumIndex(total, 0, 2)] = rowDy * rowSums[sumIndex(total, 0, 0)];
+    rowSums[sumIndex(total, 1, 2)] = rowDy * rowSums[sumIndex(total, 0, 1)];
+    for (int b = 2; b < total; ++b)
+      rowSums[sumIndex(total, 2, b)] = rowDy * rowSums[sumIndex(total, 0, b)];
     for (int e = 0; e < count; ++e) sums[e] += rowSums[e];
   }
 }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 #include <vector>
@@ -45,6 +46,18 @@ inline void storeLanes(float* p, Lanes v) {
 
 inline Lanes splat(float v) {
   return Lanes{} + v;
+}
+
+// Whether every lane is +0 (weights are never negative): the bits OR-folded in halves.
+inline bool allZero(Lanes v) {
+  using Bits16 = uint32_t __attribute__((vector_size(16 * sizeof(uint32_t))));
+  static_assert(sizeof(Bits16) == sizeof(Lanes));
+  const Bits16 b16 = (Bits16)v;  // the same bits (a vector conversion between equal sizes)
+  const auto b8 = __builtin_shufflevector(b16, b16, 0, 1, 2, 3, 4, 5, 6, 7) |
+                  __builtin_shufflevector(b16, b16, 8, 9, 10, 11, 12, 13, 14, 15);
+  const auto b4 =
+      __builtin_shufflevector(b8, b8, 0, 1, 2, 3) | __builtin_shufflevector(b8, b8, 4, 5, 6, 7);
+  return ((b4[0] | b4[1]) | (b4[2] | b4[3])) == 0;
 }
 
 // Columns of the design matrix and of the data: d ≤ kMaxGramSize, C ≤ kMaxGramRhs.
@@ -95,6 +108,10 @@ constexpr int sumIndex(int total, int a, int b) {
   return a * total - a * (a - 1) / 2 + (b - a);
 }
 
+// A weight of exactly 0 adds exactly 0 (the values it multiplies are finite), so offsets where
+// every centre of the group has one are skipped — neighbours across a strong edge, outside the
+// image. accumulateSums marks them (skip[offsetIndex(δ)]) for accumulatePredictions.
+//
 // sums (see kMaxSums) = Σ_δ w_δ · x_a · x_b for every centre of the group. Each window row is
 // summed on its own first and then added (two-level summation: shorter float sums). Column 2
 // is dy, constant along a window row, so its sums are dy times the row's sums with column 0
@@ -103,7 +120,7 @@ constexpr int sumIndex(int total, int a, int b) {
 // table's planes are far apart, and this way it is read only once.
 template <int kD, int kC>
 [[gnu::always_inline]] inline void accumulateSumsOf(const Group& g, Lanes* sums,
-                                                    float* groupWeights) {
+                                                    float* groupWeights, uint8_t* skip) {
   const int d = kD ? kD : g.d, C = kD ? kC : g.channels, total = d + C;
   const int count = d * (d + 1) / 2 + d * C;
   Lanes fp[kMaxGramSize], x[kMaxColumns], rowSums[kMaxSums];
@@ -118,6 +135,8 @@ template <int kD, int kC>
       const Lanes w = loadLanes(offsetWeights(g, dx, dy));
       storeLanes(groupWeights, w);
       groupWeights += kLanes;
+      *skip = allZero(w);
+      if (*skip++) continue;
       designRow(g, d, C, fp, dx, dy, x);
       if constexpr (kD > 0) {
 #pragma GCC unroll 32
@@ -146,11 +165,12 @@ template <int kD, int kC>
   }
 }
 
-CHORUS_SIMD_CLONES void accumulateSums(const Group& g, Lanes* sums, float* groupWeights) {
+CHORUS_SIMD_CLONES void accumulateSums(const Group& g, Lanes* sums, float* groupWeights,
+                                       uint8_t* skip) {
   if (g.d == kNforColumns && g.channels == kNforChannels)
-    accumulateSumsOf<kNforColumns, kNforChannels>(g, sums, groupWeights);
+    accumulateSumsOf<kNforColumns, kNforChannels>(g, sums, groupWeights, skip);
   else
-    accumulateSumsOf<0, 0>(g, sums, groupWeights);
+    accumulateSumsOf<0, 0>(g, sums, groupWeights, skip);
 }
 
 // acc_c(q) += w_δ(p) · x_qᵀ β_c(p) and wsum(q) += w_δ(p) for every q = p + δ of the group's
@@ -159,6 +179,7 @@ CHORUS_SIMD_CLONES void accumulateSums(const Group& g, Lanes* sums, float* group
 template <int kD, int kC>
 [[gnu::always_inline]] inline void accumulatePredictionsOf(const Group& g,
                                                            const float* groupWeights,
+                                                           const uint8_t* skip,
                                                            const Lanes* beta, float* acc,
                                                            size_t accWidth, size_t accPlane,
                                                            size_t accAt) {
@@ -169,6 +190,7 @@ template <int kD, int kC>
     for (int dx = -g.r; dx <= g.r; ++dx) {
       const Lanes w = loadLanes(groupWeights);
       groupWeights += kLanes;
+      if (*skip++) continue;
       designRow(g, d, 0, fp, dx, dy, x);
       float* at = acc + accAt + ptrdiff_t(dy) * ptrdiff_t(accWidth) + dx;
       for (int c = 0; c < C; ++c) {
@@ -183,13 +205,13 @@ template <int kD, int kC>
 }
 
 CHORUS_SIMD_CLONES void accumulatePredictions(const Group& g, const float* groupWeights,
-                                              const Lanes* beta, float* acc, size_t accWidth,
-                                              size_t accPlane, size_t accAt) {
+                                              const uint8_t* skip, const Lanes* beta, float* acc,
+                                              size_t accWidth, size_t accPlane, size_t accAt) {
   if (g.d == kNforColumns && g.channels == kNforChannels)
-    accumulatePredictionsOf<kNforColumns, kNforChannels>(g, groupWeights, beta, acc, accWidth,
-                                                         accPlane, accAt);
+    accumulatePredictionsOf<kNforColumns, kNforChannels>(g, groupWeights, skip, beta, acc,
+                                                         accWidth, accPlane, accAt);
   else
-    accumulatePredictionsOf<0, 0>(g, groupWeights, beta, acc, accWidth, accPlane, accAt);
+    accumulatePredictionsOf<0, 0>(g, groupWeights, skip, beta, acc, accWidth, accPlane, accAt);
 }
 
 // A tile: kTileSize columns starting at x0 (the last tile of a row may extend past the image:
@@ -204,6 +226,7 @@ struct ThreadState {
   std::vector<float> table;  // weights [offset][tile pixel], tile rows kTileSize wide
   Lanes sums[kMaxSums];
   std::vector<float> groupWeights;  // w_δ of one group, offset after offset
+  std::vector<uint8_t> skip;        // per offset: every weight of the group is 0
 };
 
 class Regression {
@@ -272,6 +295,7 @@ class Regression {
     const size_t accWidth = size_t(out.extent.width()), accPlane = size_t(out.extent.area());
     out.acc.assign(accPlane * size_t(channels_ + 1), 0.0f);
     st.groupWeights.resize(size_t(side_ * side_) * kLanes);
+    st.skip.resize(size_t(side_ * side_));
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x0 = tile.x0; x0 < std::min(tile.x1, width_); x0 += kLanes) {
         const Group g{.x0 = x0,
@@ -283,12 +307,12 @@ class Regression {
                                  size_t(x0 - tile.x0),
                       .weightStride = planeStride(),
                       .fu = &fu_};
-        accumulateSums(g, st.sums, st.groupWeights.data());
+        accumulateSums(g, st.sums, st.groupWeights.data(), st.skip.data());
         Lanes beta[kMaxGramSize * kMaxGramRhs];
         solveLanes(st.sums, std::min(kLanes, width_ - x0), beta);
         const size_t at = size_t(y - out.extent.y0) * accWidth + size_t(x0 - out.extent.x0);
-        accumulatePredictions(g, st.groupWeights.data(), beta, out.acc.data(), accWidth,
-                              accPlane, at);
+        accumulatePredictions(g, st.groupWeights.data(), st.skip.data(), beta, out.acc.data(),
+                              accWidth, accPlane, at);
       }
   }
 

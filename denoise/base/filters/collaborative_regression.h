@@ -7,7 +7,9 @@
 // then every q ∈ Ω_p receives the prediction x_qᵀ β_p with weight w_q:
 //   out(q) = Σ_p w_pq x_qᵀ β_p / Σ_p w_pq.
 // Tiles of 32×32 centres run in parallel (TBB); their accumulators are gathered in a fixed
-// order, so the result does not depend on the thread count.
+// order, so the result does not depend on the thread count. Within a tile, sixteen consecutive
+// centres of a row are regressed together, one per vector lane (AVX-512, AVX2 and baseline
+// builds give the same bits).
 #include "denoise/base/filters/gram_solver.h"
 #include "denoise/base/filters/nlmeans_weights.h"
 #include "denoise/image/image.h"

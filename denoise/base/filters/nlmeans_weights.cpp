@@ -87,7 +87,8 @@ CHORUS_SIMD_CLONES void weightRow(const float* distance, int n, float threshold,
     w[x] = -(kMaxExpArgument < v ? kMaxExpArgument : v);
   }
   expNonPositiveInPlace(w, size_t(n));
-  for (int x = 0; x < n; ++x) w[x] = w[x] < threshold ? 0.0f : w[x];
+  if (threshold > 0.0f)  // weights are ≥ 0: no threshold, nothing to zero
+    for (int x = 0; x < n; ++x) w[x] = w[x] < threshold ? 0.0f : w[x];
 }
 
 }  // namespace

@@ -16,11 +16,15 @@
 // full buffer; the time is the best of `--repeat` runs of BaseDenoiser::run. `--oracle` adds,
 // per case, the relMSE of choosing per pixel the best output (using the reference): with all
 // methods and with each one left out — how much each member could add to an ensemble.
+// `--save-outputs DIR` writes every output to DIR/<case>-<method>.exr; `--compare-to DIR` prints
+// each output's largest absolute and relative difference from such a saved one (a speed change
+// should move them by float rounding only).
 #include <tbb/global_control.h>
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -57,6 +61,7 @@ struct BenchOptions {
   int repeat = 1;
   bool oracle = false;
   std::string methods;  // comma-separated specs; empty = every registered denoiser
+  std::string saveOutputs, compareTo;  // directories ("" = none)
 };
 
 struct BenchCase {
@@ -166,6 +171,30 @@ Timing timeRun(const BaseDenoiser& denoiser, const DenoiseInput& input, Image& o
           processCpuSeconds() - cpuStart};
 }
 
+// Output file of one case and method: its index in the case list and the method spec.
+fs::path outputPath(const std::string& dir, size_t caseIndex, const std::string& spec) {
+  std::string name = std::to_string(caseIndex) + "-" + spec;
+  for (char& ch : name)
+    if (ch == '/' || ch == ' ') ch = '_';
+  return fs::path(dir) / (name + ".exr");
+}
+
+// Largest |a − b| and |a − b| / max(|a|, |b|) over all values (0 / 0 counts as 0).
+void printDifference(const std::string& what, const Image& a, const Image& b) {
+  if (!a.sameShape(b)) {
+    std::printf("  %s: shapes differ\n", what.c_str());
+    return;
+  }
+  double maxAbs = 0, maxRel = 0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    const double x = a.data()[k], y = b.data()[k], d = std::abs(x - y);
+    const double scale = std::max(std::abs(x), std::abs(y));
+    maxAbs = std::max(maxAbs, d);
+    if (scale > 0) maxRel = std::max(maxRel, d / scale);
+  }
+  std::printf("  %s: max |diff| %.3g, max rel diff %.3g\n", what.c_str(), maxAbs, maxRel);
+}
+
 // relMSE of the per-pixel best of `outputs` (those with include[i]), judged by the reference.
 double oracleRelMse(const std::vector<Image>& outputs, const std::vector<bool>& include,
                     const Image& reference) {
@@ -231,7 +260,8 @@ void run(const BenchOptions& o) {
   std::printf(
       "| case | method | s/Mpx | cpu s/Mpx | relMSE | relMSE noisy |\n"
       "|---|---|---:|---:|---:|---:|\n");
-  for (const BenchCase& c : cases) {
+  for (size_t caseIndex = 0; caseIndex < cases.size(); ++caseIndex) {
+    const BenchCase& c = cases[caseIndex];
     const double megapixels = double(c.input.width()) * c.input.height() / 1e6;
     const double noisy = relMse(c.input.whole.color.mean, c.reference);
     std::vector<Image> outputs;
@@ -253,10 +283,20 @@ void run(const BenchOptions& o) {
                   best.wallSeconds / megapixels, best.cpuSeconds / megapixels,
                   relMse(output, c.reference), noisy);
       std::fflush(stdout);
+      if (!o.saveOutputs.empty()) {
+        fs::create_directories(o.saveOutputs);
+        writeExr(outputPath(o.saveOutputs, caseIndex, spec), output);
+      }
       outputs.push_back(std::move(output));
       ran.push_back(spec);
     }
     if (o.oracle) printOracle(c, ran, outputs);
+    if (!o.compareTo.empty()) {
+      std::printf("\ndifferences from %s:\n", o.compareTo.c_str());
+      for (size_t i = 0; i < ran.size(); ++i)
+        printDifference(c.name + " " + ran[i], outputs[i],
+                        readRgbExr(outputPath(o.compareTo, caseIndex, ran[i])));
+    }
   }
 }
 
@@ -285,6 +325,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 100));
   app.add_flag("--oracle", o.oracle, "per-pixel oracle selection, with each method left out");
   app.add_option("--methods", o.methods, "comma-separated denoiser specs (default: all)");
+  app.add_option("--save-outputs", o.saveOutputs, "directory to write every output to (EXR)");
+  app.add_option("--compare-to", o.compareTo,
+                 "directory of outputs saved by --save-outputs: print the largest differences");
   CLI11_PARSE(app, argc, argv);
   try {
     chorus::bench::run(o);

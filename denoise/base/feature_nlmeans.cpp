@@ -10,6 +10,7 @@
 #include "denoise/base/filters/pixel_rect.h"
 #include "denoise/base/nlmeans_row_kernels.h"
 #include "denoise/base/bordered_planes.h"
+#include "denoise/base/rect_mask.h"
 #include "denoise/util/float_lanes.h"
 
 namespace chorus {
@@ -28,18 +29,6 @@ struct ValidRects {
     rect[kSym] = rect[kPlus].intersect(rect[kMinus]);
   }
 };
-
-// 1 inside `valid`, 0 elsewhere, over the rectangle `area` (row-major).
-void fillMask(const PixelRect& area, const PixelRect& valid, float* mask) {
-  const int w = area.width();
-  for (int y = area.y0; y < area.y1; ++y) {
-    float* row = mask + size_t(y - area.y0) * size_t(w);
-    std::fill(row, row + w, 0.0f);
-    if (y < valid.y0 || y >= valid.y1) continue;
-    const int a = std::clamp(valid.x0 - area.x0, 0, w), b = std::clamp(valid.x1 - area.x0, 0, w);
-    std::fill(row + a, row + std::max(a, b), 1.0f);
-  }
-}
 
 // dst (over `out`) = box mean of src (over `in`, which contains `out` grown by r) of radius r,
 // each sum divided by the number of pixels of `valid` in the box (src is 0 outside `valid`).
@@ -264,11 +253,11 @@ void FeatureNlMeansKernel::patchWeights(const PixelRect& tile, int dx, int dy,
   }
   // Patch means over the grid (the tile grown by the weight box), counting valid pixels only.
   for (int kind = 0; kind < 3; ++kind) {
-    fillMask(ext, valid.rect[kind], m.gridMask[kind].data());  // scratch: the ext mask
+    fillRectMask(ext, valid.rect[kind], m.gridMask[kind].data());  // scratch: the ext mask
     for (size_t i = 0; i < eArea; ++i) m.ext[kind][i] *= m.gridMask[kind][i];
     boxMean(m.ext[kind].data(), ext, m.dist[kind].data(), grid, f_, valid.rect[kind], m.rowSums,
             m.invX);
-    fillMask(grid, valid.rect[kind], m.gridMask[kind].data());
+    fillRectMask(grid, valid.rect[kind], m.gridMask[kind].data());
   }
   for (int y = grid.y0; y < grid.y1; ++y) {
     const size_t r = size_t(y - grid.y0) * size_t(gw);
@@ -315,7 +304,7 @@ void FeatureNlMeansKernel::runTile(const PixelRect& tile, TileMemory& m,
   for (int dy = 0; dy <= r; ++dy)
     for (int dx = dy == 0 ? 1 : -r; dx <= r; ++dx) {
       const ValidRects valid(width_, height_, dx, dy);
-      for (int kind = 0; kind < 3; ++kind) fillMask(tile, valid.rect[kind], m.mask[kind].data());
+      for (int kind = 0; kind < 3; ++kind) fillRectMask(tile, valid.rect[kind], m.mask[kind].data());
       featureWeights(tile, dx, dy, m);
       const float* wPlus = m.featPlus.data();
       const float* wMinus = m.featMinus.data();

@@ -11,6 +11,7 @@
 #include "denoise/base/filters/pixel_rect.h"
 #include "denoise/base/nlmeans_row_kernels.h"
 #include "denoise/base/bordered_planes.h"
+#include "denoise/base/rect_mask.h"
 #include "denoise/base/sure.h"
 #include "denoise/util/float_lanes.h"
 
@@ -121,18 +122,15 @@ CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& 
 }
 
 void CandidateKernel::masks(const PixelRect& tile, int dx, int dy, TileMemory& m) const {
-  auto inside = [&](int x, int y) { return x >= 0 && y >= 0 && x < width_ && y < height_; };
-  const int tw = tile.width();
-  for (int y = tile.y0; y < tile.y1; ++y)
-    for (int x = tile.x0; x < tile.x1; ++x) {
-      const size_t i = size_t(y - tile.y0) * size_t(tw) + size_t(x - tile.x0);
-      const bool plus = inside(x + dx, y + dy), minus = inside(x - dx, y - dy);
-      m.mask[kPlus][i] = plus ? 1.0f : 0.0f;
-      m.mask[kMinus][i] = minus ? 1.0f : 0.0f;
-      m.mask[kSym][i] = plus && minus ? 1.0f : 0.0f;
-      m.mask[3][i] = minus && inside(x - 2 * dx, y - 2 * dy) ? 1.0f : 0.0f;
-      m.mask[4][i] = plus && inside(x + 2 * dx, y + 2 * dy) ? 1.0f : 0.0f;
-    }
+  const PixelRect plus = neighbourInside(width_, height_, dx, dy);
+  const PixelRect minus = neighbourInside(width_, height_, -dx, -dy);
+  fillRectMask(tile, plus, m.mask[kPlus].data());
+  fillRectMask(tile, minus, m.mask[kMinus].data());
+  fillRectMask(tile, plus.intersect(minus), m.mask[kSym].data());
+  fillRectMask(tile, minus.intersect(neighbourInside(width_, height_, -2 * dx, -2 * dy)),
+               m.mask[3].data());
+  fillRectMask(tile, plus.intersect(neighbourInside(width_, height_, 2 * dx, 2 * dy)),
+               m.mask[4].data());
 }
 
 void CandidateKernel::featureWeights(const PixelRect& tile, int dx, int dy, TileMemory& m) const {

@@ -38,50 +38,53 @@ inline float refineFactor(float w1, float w2, float ws, float mask, float minWei
   return (mask > 0.0f) & (w1 >= minWeight) & (w2 >= minWeight) ? a : 0.0f;
 }
 
+// One term's refined weights for δ and −δ from its distance sums (× scale, the channel mean),
+// min'd into outPlus / outMinus.
+inline void refinedTermWeights(float scale, float dPlus, float dMinus, float dSym, float symMask,
+                               float minRefineWeight, float& outPlus, float& outMinus) {
+  const float w1 = weightOf(scale * dPlus), w2 = weightOf(scale * dMinus);
+  const float ws = weightOf(scale * dSym);
+  const float a = refineFactor(w1, w2, ws, symMask, minRefineWeight);
+  outPlus = std::min(outPlus, a * ws + (1.0f - a) * w1);
+  outMinus = std::min(outMinus, a * ws + (1.0f - a) * w2);
+}
+
 }  // namespace
-
-ROW_KERNEL
-void addPairDistance(int n, const float* __restrict f, const float* __restrict fq,
-                     const float* __restrict vn, const float* __restrict vnq,
-                     const float* __restrict denA, const float* __restrict denAq,
-                     const float* __restrict denB, const float* __restrict denBq,
-                     float* __restrict outA, float* __restrict outB) {
-  for (int i = 0; i < n; ++i) {
-    const float diff = f[i] - fq[i];
-    const float num = diff * diff - (vn[i] + std::min(vn[i], vnq[i]));
-    outA[i] += clampDistance(num / (denA[i] + denAq[i] + kEpsilon));
-    outB[i] += clampDistance(num / (denB[i] + denBq[i] + kEpsilon));
-  }
-}
-
-ROW_KERNEL
-void addSymmetricDistance(int n, const float* __restrict f, const float* __restrict fp,
-                          const float* __restrict fm, const float* __restrict vn,
-                          const float* __restrict vnp, const float* __restrict vnm,
-                          const float* __restrict denA, const float* __restrict denAp,
-                          const float* __restrict denAm, const float* __restrict denB,
-                          const float* __restrict denBp, const float* __restrict denBm,
-                          float* __restrict outA, float* __restrict outB) {
-  for (int i = 0; i < n; ++i) {
-    const float diff = f[i] - 0.5f * (fp[i] + fm[i]);
-    const float num =
-        diff * diff - (vn[i] + 0.25f * (std::min(vn[i], vnp[i]) + std::min(vn[i], vnm[i])));
-    outA[i] += clampDistance(num / (denA[i] + 0.25f * (denAp[i] + denAm[i]) + kEpsilon));
-    outB[i] += clampDistance(num / (denB[i] + 0.25f * (denBp[i] + denBm[i]) + kEpsilon));
-  }
-}
 
 ROW_KERNEL
 void minTermWeights(int n, float scale, const float* __restrict dPlus,
                     const float* __restrict dMinus, const float* __restrict dSym,
                     const float* __restrict symMask, float minRefineWeight,
                     float* __restrict outPlus, float* __restrict outMinus) {
+  for (int i = 0; i < n; ++i)
+    refinedTermWeights(scale, dPlus[i], dMinus[i], dSym[i], symMask[i], minRefineWeight,
+                       outPlus[i], outMinus[i]);
+}
+
+ROW_KERNEL
+void addFeatureDistancesTwoFloors(int n, const float* __restrict f, const float* __restrict fp,
+                                  const float* __restrict fm, const float* __restrict vn,
+                                  const float* __restrict vnp, const float* __restrict vnm,
+                                  const float* __restrict kv, const float* __restrict kvp,
+                                  const float* __restrict kvm, float floorA, float floorB,
+                                  float* __restrict plusA, float* __restrict minusA,
+                                  float* __restrict symA, float* __restrict plusB,
+                                  float* __restrict minusB, float* __restrict symB) {
   for (int i = 0; i < n; ++i) {
-    const float w1 = weightOf(scale * dPlus[i]), w2 = weightOf(scale * dMinus[i]);
-    const float ws = weightOf(scale * dSym[i]);
-    const float a = refineFactor(w1, w2, ws, symMask[i], minRefineWeight);
-    outPlus[i] = std::min(outPlus[i], a * ws + (1.0f - a) * w1);
-    outMinus[i] = std::min(outMinus[i], a * ws + (1.0f - a) * w2);
+    const float v = vn[i], mp = std::min(v, vnp[i]), mm = std::min(v, vnm[i]);
+    const float diffP = f[i] - fp[i], diffM = f[i] - fm[i];
+    const float diffS = f[i] - 0.5f * (fp[i] + fm[i]);
+    const float numP = diffP * diffP - (v + mp), numM = diffM * diffM - (v + mm);
+    const float numS = diffS * diffS - (v + 0.25f * (mp + mm));
+    const float denA = std::max(kv[i], floorA), denB = std::max(kv[i], floorB);
+    const float denAP = std::max(kvp[i], floorA), denAM = std::max(kvm[i], floorA);
+    const float denBP = std::max(kvp[i], floorB), denBM = std::max(kvm[i], floorB);
+    plusA[i] += clampDistance(numP / (denA + denAP + kEpsilon));
+    minusA[i] += clampDistance(numM / (denA + denAM + kEpsilon));
+    symA[i] += clampDistance(numS / (denA + 0.25f * (denAP + denAM) + kEpsilon));
+    plusB[i] += clampDistance(numP / (denB + denBP + kEpsilon));
+    minusB[i] += clampDistance(numM / (denB + denBM + kEpsilon));
+    symB[i] += clampDistance(numS / (denB + 0.25f * (denBP + denBM) + kEpsilon));
   }
 }
 

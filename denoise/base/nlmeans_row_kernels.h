@@ -13,17 +13,16 @@
 
 namespace chorus::rows {
 
-// out += min(clamp, [(f − fq)² − (vn + min(vn, vnq))] / (den + denq + ε)) for two denominator
-// sets (A, B): one feature channel's pixel distance to p + δ.
-void addPairDistance(int n, const float* f, const float* fq, const float* vn, const float* vnq,
-                     const float* denA, const float* denAq, const float* denB, const float* denBq,
-                     float* outA, float* outB);
-
-// The same for the symmetric distance from p to the mean of p + δ and p − δ.
-void addSymmetricDistance(int n, const float* f, const float* fp, const float* fm, const float* vn,
-                          const float* vnp, const float* vnm, const float* denA, const float* denAp,
-                          const float* denAm, const float* denB, const float* denBp,
-                          const float* denBm, float* outA, float* outB);
+// One feature channel's clamped pixel distances [(f − fq)² − (vn + min(vn, vnq))] / (den + denq + ε)
+// to p + δ and p − δ, and to their mean (numerator variance vn + ¼ (min(vn, vnp) + min(vn, vnm)),
+// denominator den + ¼ (denp + denm) + ε), added to plus / minus / sym for two denominator sets,
+// den = max(kv, floorA) and max(kv, floorB) (RDFC's two τ): one pass over the planes for the
+// six distances.
+void addFeatureDistancesTwoFloors(int n, const float* f, const float* fp, const float* fm,
+                                  const float* vn, const float* vnp, const float* vnm,
+                                  const float* kv, const float* kvp, const float* kvm, float floorA,
+                                  float floorB, float* plusA, float* minusA, float* symA,
+                                  float* plusB, float* minusB, float* symB);
 
 // Weights exp(−max(0, scale · d)) of one term for δ and −δ, refined with the symmetric weight
 // where symMask = 1 and both weights ≥ minRefineWeight, then out = min(out, weight).

@@ -31,7 +31,7 @@ enum Kind { kPlus, kMinus, kSym };
 struct TileMemory {
   std::vector<float> mask[5];  // plus, minus, sym, behind (p−δ, p−2δ), ahead (p+δ, p+2δ)
   std::vector<float> featPlus[2], featMinus[2];  // feature weights, τ sets FIRST/SECOND, THIRD
-  std::vector<float> termRow[6];                 // one term's distances: A ±/s, B ±/s
+  std::vector<float> termRow[6];                 // one term's distances: A +/−/s, B +/−/s
   std::vector<float> ext[3];                     // colour pixel distances over the grown tile
   std::vector<float> rowSums, invCountX;         // box filter: horizontal sums, 1 / x counts
   std::vector<float> dist[kColor][3], invCount[kColor][3];
@@ -68,9 +68,12 @@ class CandidateKernel {
   float refineMinWeight_;
   Image guide_, variance_;
   BorderedPlanes b1_, b2_, g_, vn_, vd_;
-  // Features: one plane per channel of every feature, its term's channel range.
-  BorderedPlanes fValue_, fNum_, fDen_[2];
+  // Features: one plane per channel of every feature, its term's channel range. The
+  // denominators of the two τ sets are max(k_f² max(Var, G), floor) (k_f² is positive, so
+  // scaling commutes with the max): one plane for both, a floor per term and set.
+  BorderedPlanes fValue_, fNum_, fDen_;
   std::vector<int> termBegin_;
+  std::vector<float> termFloor_[2];
 };
 
 CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& variance,
@@ -108,17 +111,21 @@ CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& 
   termBegin_.push_back(channels);
   fValue_ = BorderedPlanes(width_, height_, channels, pad_);
   fNum_ = BorderedPlanes(width_, height_, channels, pad_);
-  const float tau[2] = {params.tauFirstSecond, params.tauThird};
-  for (int set = 0; set < 2; ++set) fDen_[set] = BorderedPlanes(width_, height_, channels, pad_);
+  fDen_ = BorderedPlanes(width_, height_, channels, pad_);
   const float kf2 = params.kf * params.kf;
   for (size_t j = 0; j < features.size(); ++j) {
     const RdfcFeature& f = features[j];
+    // Vn without the τ floor: RDFC's normalizing variance with τ = 0 (kNeutralVariance where
+    // unknown, which stays above every floor).
+    const Image unfloored = f.normalizingVariance(0.0f);
     for (int c = 0; c < f.value.channels(); ++c) {
       const int k = termBegin_[j] + c;
       fValue_.set(k, f.value, c, 1.0f);
       fNum_.set(k, f.variance, c, 1.0f);  // α = 1
-      for (int set = 0; set < 2; ++set) fDen_[set].set(k, f.normalizingVariance(tau[set]), c, kf2);
+      fDen_.set(k, unfloored, c, kf2);
     }
+    termFloor_[0].push_back(kf2 * (params.tauFirstSecond * f.tauScale));
+    termFloor_[1].push_back(kf2 * (params.tauThird * f.tauScale));
   }
 }
 
@@ -135,7 +142,7 @@ void CandidateKernel::masks(const PixelRect& tile, int dx, int dy, TileMemory& m
 }
 
 void CandidateKernel::featureWeights(const PixelRect& tile, int dx, int dy, TileMemory& m) const {
-  const int tw = tile.width();
+  const int tw = tile.width(), x0 = tile.x0;
   const size_t area = size_t(tile.area());
   for (int set = 0; set < 2; ++set) {
     std::fill(m.featPlus[set].begin(), m.featPlus[set].begin() + ptrdiff_t(area), 1.0f);
@@ -143,29 +150,16 @@ void CandidateKernel::featureWeights(const PixelRect& tile, int dx, int dy, Tile
   }
   for (int y = tile.y0; y < tile.y1; ++y) {
     const size_t row = size_t(y - tile.y0) * size_t(tw);
-    const int x0 = tile.x0;
     for (size_t term = 0; term + 1 < termBegin_.size(); ++term) {
       for (auto& r : m.termRow) std::fill(r.begin(), r.begin() + tw, 0.0f);
-      for (int k = termBegin_[term]; k < termBegin_[term + 1]; ++k) {
-        const float* f = fValue_.row(k, y) + x0;
-        const float* fp = fValue_.row(k, y + dy) + x0 + dx;
-        const float* fm = fValue_.row(k, y - dy) + x0 - dx;
-        const float* n = fNum_.row(k, y) + x0;
-        const float* np = fNum_.row(k, y + dy) + x0 + dx;
-        const float* nm = fNum_.row(k, y - dy) + x0 - dx;
-        const float* a = fDen_[0].row(k, y) + x0;
-        const float* ap = fDen_[0].row(k, y + dy) + x0 + dx;
-        const float* am = fDen_[0].row(k, y - dy) + x0 - dx;
-        const float* b = fDen_[1].row(k, y) + x0;
-        const float* bp = fDen_[1].row(k, y + dy) + x0 + dx;
-        const float* bm = fDen_[1].row(k, y - dy) + x0 - dx;
-        rows::addPairDistance(tw, f, fp, n, np, a, ap, b, bp, m.termRow[0].data(),
-                              m.termRow[3].data());
-        rows::addPairDistance(tw, f, fm, n, nm, a, am, b, bm, m.termRow[1].data(),
-                              m.termRow[4].data());
-        rows::addSymmetricDistance(tw, f, fp, fm, n, np, nm, a, ap, am, b, bp, bm,
-                                   m.termRow[2].data(), m.termRow[5].data());
-      }
+      for (int k = termBegin_[term]; k < termBegin_[term + 1]; ++k)
+        rows::addFeatureDistancesTwoFloors(
+            tw, fValue_.row(k, y) + x0, fValue_.row(k, y + dy) + x0 + dx,
+            fValue_.row(k, y - dy) + x0 - dx, fNum_.row(k, y) + x0, fNum_.row(k, y + dy) + x0 + dx,
+            fNum_.row(k, y - dy) + x0 - dx, fDen_.row(k, y) + x0, fDen_.row(k, y + dy) + x0 + dx,
+            fDen_.row(k, y - dy) + x0 - dx, termFloor_[0][term], termFloor_[1][term],
+            m.termRow[0].data(), m.termRow[1].data(), m.termRow[2].data(), m.termRow[3].data(),
+            m.termRow[4].data(), m.termRow[5].data());
       const float scale = 1.0f / float(termBegin_[term + 1] - termBegin_[term]);
       for (int set = 0; set < 2; ++set)
         rows::minTermWeights(tw, scale, m.termRow[3 * set].data(), m.termRow[3 * set + 1].data(),
@@ -377,11 +371,11 @@ void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out
   const size_t area = size_t(tile.area());
   const size_t grownArea = size_t(kTileWidth + 2 * grow_) * size_t(kTileHeight + 2 * grow_);
   for (auto& v : m.mask) v.resize(area);
+  for (auto& v : m.termRow) v.resize(kTileWidth);
   for (int set = 0; set < 2; ++set) {
     m.featPlus[set].resize(area);
     m.featMinus[set].resize(area);
   }
-  for (auto& v : m.termRow) v.resize(kTileWidth);
   for (auto& v : m.ext) v.resize(grownArea);
   m.rowSums.resize(size_t(kTileWidth) * size_t(kTileHeight + 2 * grow_));
   m.invCountX.resize(kTileWidth);

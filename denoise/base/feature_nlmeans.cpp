@@ -253,8 +253,10 @@ void FeatureNlMeansKernel::patchWeights(const PixelRect& tile, int dx, int dy,
   }
   // Patch means over the grid (the tile grown by the weight box), counting valid pixels only.
   for (int kind = 0; kind < 3; ++kind) {
-    fillRectMask(ext, valid.rect[kind], m.gridMask[kind].data());  // scratch: the ext mask
-    for (size_t i = 0; i < eArea; ++i) m.ext[kind][i] *= m.gridMask[kind][i];
+    if (ext.intersect(valid.rect[kind]) != ext) {  // × 1 changes nothing (not even a NaN)
+      fillRectMask(ext, valid.rect[kind], m.gridMask[kind].data());  // scratch: the ext mask
+      for (size_t i = 0; i < eArea; ++i) m.ext[kind][i] *= m.gridMask[kind][i];
+    }
     boxMean(m.ext[kind].data(), ext, m.dist[kind].data(), grid, f_, valid.rect[kind], m.rowSums,
             m.invX);
     fillRectMask(grid, valid.rect[kind], m.gridMask[kind].data());

@@ -149,8 +149,38 @@ void addFeatureDistances(int n, const float* __restrict f, const float* __restri
   }
 }
 
+// The box sums below add the taps in a register, in the same order as a row-by-row
+// accumulation would (so the same sums), for the radii the filters use (patch radii 1 and 3,
+// weight box 2); other radii take the generic loops.
+template <int R>
+inline void horizontalBoxSumOf(int n, const float* __restrict src, float* __restrict dst) {
+  for (int i = 0; i < n; ++i) {
+    float sum = src[i - R];
+#pragma GCC unroll 8
+    for (int j = -R + 1; j <= R; ++j) sum += src[i + j];
+    dst[i] = sum;
+  }
+}
+
+template <int Count>
+inline void verticalBoxMeanOf(int n, const float* __restrict src, size_t stride, float scaleY,
+                              const float* __restrict scaleX, float* __restrict dst) {
+  for (int i = 0; i < n; ++i) {
+    float sum = src[i];
+#pragma GCC unroll 8
+    for (int j = 1; j < Count; ++j) sum += src[size_t(j) * stride + size_t(i)];
+    dst[i] = sum * (scaleY * scaleX[i]);
+  }
+}
+
 ROW_KERNEL
 void horizontalBoxSum(int n, const float* __restrict src, int r, float* __restrict dst) {
+  switch (r) {
+    case 1: return horizontalBoxSumOf<1>(n, src, dst);
+    case 2: return horizontalBoxSumOf<2>(n, src, dst);
+    case 3: return horizontalBoxSumOf<3>(n, src, dst);
+    default: break;
+  }
   for (int i = 0; i < n; ++i) dst[i] = src[i - r];
   for (int j = -r + 1; j <= r; ++j)
     for (int i = 0; i < n; ++i) dst[i] += src[i + j];
@@ -159,6 +189,12 @@ void horizontalBoxSum(int n, const float* __restrict src, int r, float* __restri
 ROW_KERNEL
 void verticalBoxMean(int n, const float* __restrict src, size_t stride, int count, float scaleY,
                      const float* __restrict scaleX, float* __restrict dst) {
+  switch (count) {
+    case 3: return verticalBoxMeanOf<3>(n, src, stride, scaleY, scaleX, dst);
+    case 5: return verticalBoxMeanOf<5>(n, src, stride, scaleY, scaleX, dst);
+    case 7: return verticalBoxMeanOf<7>(n, src, stride, scaleY, scaleX, dst);
+    default: break;
+  }
   for (int i = 0; i < n; ++i) dst[i] = src[i];
   for (int j = 1; j < count; ++j) {
     const float* __restrict row = src + size_t(j) * stride;

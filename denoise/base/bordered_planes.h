@@ -29,6 +29,8 @@ class BorderedPlanes {
   float* mutableRow(int c, int y) {
     return data_.data() + size_t(c) * planeSize_ + size_t(y + pad_) * stride_ + size_t(pad_);
   }
+  // Floats from a pixel of channel c to the same pixel of channel c + 1.
+  size_t planeStride() const { return planeSize_; }
   // Pointer to pixel (0, y) of channel c; valid for x, y within `pad` of the image.
   const float* row(int c, int y) const {
     return data_.data() + size_t(c) * planeSize_ + size_t(y + pad_) * stride_ + size_t(pad_);

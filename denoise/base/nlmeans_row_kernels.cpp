@@ -61,30 +61,65 @@ void minTermWeights(int n, float scale, const float* __restrict dPlus,
                        outPlus[i], outMinus[i]);
 }
 
-ROW_KERNEL
-void addFeatureDistancesTwoFloors(int n, const float* __restrict f, const float* __restrict fp,
-                                  const float* __restrict fm, const float* __restrict vn,
-                                  const float* __restrict vnp, const float* __restrict vnm,
-                                  const float* __restrict kv, const float* __restrict kvp,
-                                  const float* __restrict kvm, float floorA, float floorB,
-                                  float* __restrict plusA, float* __restrict minusA,
-                                  float* __restrict symA, float* __restrict plusB,
-                                  float* __restrict minusB, float* __restrict symB) {
+// featureTermWeights for C channels: the channel loop unrolled, the six distance sums in
+// registers. Each instantiation is cloned itself: a template inlined into a cloned function is
+// not vectorised for the clone's target.
+template <int C>
+ROW_KERNEL void featureTermWeightsOf(int n, size_t stride, const float* __restrict f,
+                                 const float* __restrict fp, const float* __restrict fm,
+                                 const float* __restrict vn, const float* __restrict vnp,
+                                 const float* __restrict vnm, const float* __restrict kv,
+                                 const float* __restrict kvp, const float* __restrict kvm,
+                                 float floorA, float floorB, const float* __restrict symMask,
+                                 float minRefineWeight, float* __restrict plusA,
+                                 float* __restrict minusA, float* __restrict plusB,
+                                 float* __restrict minusB) {
+  constexpr float scale = 1.0f / float(C);
   for (int i = 0; i < n; ++i) {
-    const float v = vn[i], mp = std::min(v, vnp[i]), mm = std::min(v, vnm[i]);
-    const float diffP = f[i] - fp[i], diffM = f[i] - fm[i];
-    const float diffS = f[i] - 0.5f * (fp[i] + fm[i]);
-    const float numP = diffP * diffP - (v + mp), numM = diffM * diffM - (v + mm);
-    const float numS = diffS * diffS - (v + 0.25f * (mp + mm));
-    const float denA = std::max(kv[i], floorA), denB = std::max(kv[i], floorB);
-    const float denAP = std::max(kvp[i], floorA), denAM = std::max(kvm[i], floorA);
-    const float denBP = std::max(kvp[i], floorB), denBM = std::max(kvm[i], floorB);
-    plusA[i] += clampDistance(numP / (denA + denAP + kEpsilon));
-    minusA[i] += clampDistance(numM / (denA + denAM + kEpsilon));
-    symA[i] += clampDistance(numS / (denA + 0.25f * (denAP + denAM) + kEpsilon));
-    plusB[i] += clampDistance(numP / (denB + denBP + kEpsilon));
-    minusB[i] += clampDistance(numM / (denB + denBM + kEpsilon));
-    symB[i] += clampDistance(numS / (denB + 0.25f * (denBP + denBM) + kEpsilon));
+    float plusDA = 0.0f, minusDA = 0.0f, symDA = 0.0f, plusDB = 0.0f, minusDB = 0.0f, symDB = 0.0f;
+#pragma GCC unroll 4
+    for (int c = 0; c < C; ++c) {
+      const size_t k = size_t(c) * stride + size_t(i);
+      const float v = vn[k], mp = std::min(v, vnp[k]), mm = std::min(v, vnm[k]);
+      const float diffP = f[k] - fp[k], diffM = f[k] - fm[k];
+      const float diffS = f[k] - 0.5f * (fp[k] + fm[k]);
+      const float numP = diffP * diffP - (v + mp), numM = diffM * diffM - (v + mm);
+      const float numS = diffS * diffS - (v + 0.25f * (mp + mm));
+      const float denA = std::max(kv[k], floorA), denB = std::max(kv[k], floorB);
+      const float denAP = std::max(kvp[k], floorA), denAM = std::max(kvm[k], floorA);
+      const float denBP = std::max(kvp[k], floorB), denBM = std::max(kvm[k], floorB);
+      plusDA += clampDistance(numP / (denA + denAP + kEpsilon));
+      minusDA += clampDistance(numM / (denA + denAM + kEpsilon));
+      symDA += clampDistance(numS / (denA + 0.25f * (denAP + denAM) + kEpsilon));
+      plusDB += clampDistance(numP / (denB + denBP + kEpsilon));
+      minusDB += clampDistance(numM / (denB + denBM + kEpsilon));
+      symDB += clampDistance(numS / (denB + 0.25f * (denBP + denBM) + kEpsilon));
+    }
+    refinedTermWeights(scale, plusDA, minusDA, symDA, symMask[i], minRefineWeight, plusA[i],
+                       minusA[i]);
+    refinedTermWeights(scale, plusDB, minusDB, symDB, symMask[i], minRefineWeight, plusB[i],
+                       minusB[i]);
+  }
+}
+
+void featureTermWeights(int n, int channels, size_t planeStride, const float* f, const float* fp,
+                        const float* fm, const float* vn, const float* vnp, const float* vnm,
+                        const float* kv, const float* kvp, const float* kvm, float floorA,
+                        float floorB, const float* symMask, float minRefineWeight, float* plusA,
+                        float* minusA, float* plusB, float* minusB) {
+  switch (channels) {
+#define CHORUS_TERM_CASE(C)                                                                  \
+  case C:                                                                                    \
+    return featureTermWeightsOf<C>(n, planeStride, f, fp, fm, vn, vnp, vnm, kv, kvp, kvm,    \
+                                   floorA, floorB, symMask, minRefineWeight, plusA, minusA, \
+                                   plusB, minusB);
+    CHORUS_TERM_CASE(1)
+    CHORUS_TERM_CASE(2)
+    CHORUS_TERM_CASE(3)
+    CHORUS_TERM_CASE(4)
+#undef CHORUS_TERM_CASE
+    default:
+      return;  // callers check the channel count
   }
 }
 

@@ -13,16 +13,18 @@
 
 namespace chorus::rows {
 
-// One feature channel's clamped pixel distances [(f − fq)² − (vn + min(vn, vnq))] / (den + denq + ε)
-// to p + δ and p − δ, and to their mean (numerator variance vn + ¼ (min(vn, vnp) + min(vn, vnm)),
-// denominator den + ¼ (denp + denm) + ε), added to plus / minus / sym for two denominator sets,
-// den = max(kv, floorA) and max(kv, floorB) (RDFC's two τ): one pass over the planes for the
-// six distances.
-void addFeatureDistancesTwoFloors(int n, const float* f, const float* fp, const float* fm,
-                                  const float* vn, const float* vnp, const float* vnm,
-                                  const float* kv, const float* kvp, const float* kvm, float floorA,
-                                  float floorB, float* plusA, float* minusA, float* symA,
-                                  float* plusB, float* minusB, float* symB);
+// One feature term's weights for δ and −δ under two denominator sets A, B (RDFC's two τ), min'd
+// into plusA / minusA / plusB / minusB. Per channel (1 to 4 planes, planeStride floats apart;
+// other counts do nothing) the clamped pixel distances
+// [(f − fq)² − (vn + min(vn, vnq))] / (den + denq + ε) to p ± δ, and to their mean (numerator
+// variance vn + ¼ (min(vn, vnp) + min(vn, vnm)), denominator den + ¼ (denp + denm) + ε), with
+// den = max(kv, floorA) or max(kv, floorB); their channel means give the weights as in
+// minTermWeights. One pass over the term's planes for both sets, the sums kept in registers.
+void featureTermWeights(int n, int channels, size_t planeStride, const float* f, const float* fp,
+                        const float* fm, const float* vn, const float* vnp, const float* vnm,
+                        const float* kv, const float* kvp, const float* kvm, float floorA,
+                        float floorB, const float* symMask, float minRefineWeight, float* plusA,
+                        float* minusA, float* plusB, float* minusB);
 
 // Weights exp(−max(0, scale · d)) of one term for δ and −δ, refined with the symmetric weight
 // where symMask = 1 and both weights ≥ minRefineWeight, then out = min(out, weight).

@@ -31,7 +31,6 @@ enum Kind { kPlus, kMinus, kSym };
 struct TileMemory {
   std::vector<float> mask[5];  // plus, minus, sym, behind (p−δ, p−2δ), ahead (p+δ, p+2δ)
   std::vector<float> featPlus[2], featMinus[2];  // feature weights, τ sets FIRST/SECOND, THIRD
-  std::vector<float> termRow[6];                 // one term's distances: A +/−/s, B +/−/s
   std::vector<float> ext[3];                     // colour pixel distances over the grown tile
   std::vector<float> rowSums, invCountX;         // box filter: horizontal sums, 1 / x counts
   std::vector<float> dist[kColor][3], invCount[kColor][3];
@@ -105,6 +104,8 @@ CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& 
 
   int channels = 0;
   for (const RdfcFeature& f : features) {
+    if (f.value.channels() < 1 || f.value.channels() > 4)
+      throw std::invalid_argument("rdfcCandidates: features have 1 to 4 channels");
     termBegin_.push_back(channels);
     channels += f.value.channels();
   }
@@ -148,24 +149,19 @@ void CandidateKernel::featureWeights(const PixelRect& tile, int dx, int dy, Tile
     std::fill(m.featPlus[set].begin(), m.featPlus[set].begin() + ptrdiff_t(area), 1.0f);
     std::fill(m.featMinus[set].begin(), m.featMinus[set].begin() + ptrdiff_t(area), 1.0f);
   }
+  const size_t stride = fValue_.planeStride();
   for (int y = tile.y0; y < tile.y1; ++y) {
     const size_t row = size_t(y - tile.y0) * size_t(tw);
     for (size_t term = 0; term + 1 < termBegin_.size(); ++term) {
-      for (auto& r : m.termRow) std::fill(r.begin(), r.begin() + tw, 0.0f);
-      for (int k = termBegin_[term]; k < termBegin_[term + 1]; ++k)
-        rows::addFeatureDistancesTwoFloors(
-            tw, fValue_.row(k, y) + x0, fValue_.row(k, y + dy) + x0 + dx,
-            fValue_.row(k, y - dy) + x0 - dx, fNum_.row(k, y) + x0, fNum_.row(k, y + dy) + x0 + dx,
-            fNum_.row(k, y - dy) + x0 - dx, fDen_.row(k, y) + x0, fDen_.row(k, y + dy) + x0 + dx,
-            fDen_.row(k, y - dy) + x0 - dx, termFloor_[0][term], termFloor_[1][term],
-            m.termRow[0].data(), m.termRow[1].data(), m.termRow[2].data(), m.termRow[3].data(),
-            m.termRow[4].data(), m.termRow[5].data());
-      const float scale = 1.0f / float(termBegin_[term + 1] - termBegin_[term]);
-      for (int set = 0; set < 2; ++set)
-        rows::minTermWeights(tw, scale, m.termRow[3 * set].data(), m.termRow[3 * set + 1].data(),
-                             m.termRow[3 * set + 2].data(), m.mask[kSym].data() + row,
-                             refineMinWeight_, m.featPlus[set].data() + row,
-                             m.featMinus[set].data() + row);
+      const int k = termBegin_[term];
+      rows::featureTermWeights(
+          tw, termBegin_[term + 1] - k, stride, fValue_.row(k, y) + x0,
+          fValue_.row(k, y + dy) + x0 + dx, fValue_.row(k, y - dy) + x0 - dx, fNum_.row(k, y) + x0,
+          fNum_.row(k, y + dy) + x0 + dx, fNum_.row(k, y - dy) + x0 - dx, fDen_.row(k, y) + x0,
+          fDen_.row(k, y + dy) + x0 + dx, fDen_.row(k, y - dy) + x0 - dx, termFloor_[0][term],
+          termFloor_[1][term], m.mask[kSym].data() + row, refineMinWeight_,
+          m.featPlus[0].data() + row, m.featMinus[0].data() + row, m.featPlus[1].data() + row,
+          m.featMinus[1].data() + row);
     }
   }
   for (int set = 0; set < 2; ++set)
@@ -371,7 +367,6 @@ void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out
   const size_t area = size_t(tile.area());
   const size_t grownArea = size_t(kTileWidth + 2 * grow_) * size_t(kTileHeight + 2 * grow_);
   for (auto& v : m.mask) v.resize(area);
-  for (auto& v : m.termRow) v.resize(kTileWidth);
   for (int set = 0; set < 2; ++set) {
     m.featPlus[set].resize(area);
     m.featMinus[set].resize(area);

@@ -123,6 +123,26 @@ void featureTermWeights(int n, int channels, size_t planeStride, const float* f,
   }
 }
 
+// One pixel's colour distances (addColorDistances); the reciprocals of the denominators are
+// returned for the slopes.
+inline void colorDistances(float g, float gp, float gm, float vn, float vnp, float vnm, float vd,
+                           float vdp, float vdm, float channelShare, float neighbourShare,
+                           float clamp, float& plus, float& minus, float& sym, float& invP,
+                           float& invM, float& invS) {
+  const float mp = std::min(vn, vnp), mm = std::min(vn, vnm);
+  const float diffP = g - gp, diffM = g - gm;
+  const float diffS = g - 0.5f * (gp + gm);
+  invP = 1.0f / (vd + vdp + kEpsilon);
+  invM = 1.0f / (vd + vdm + kEpsilon);
+  invS = 1.0f / (vd + neighbourShare * (vdp + vdm) + kEpsilon);
+  const float dp = channelShare * ((diffP * diffP - (vn + mp)) * invP);
+  const float dm = channelShare * ((diffM * diffM - (vn + mm)) * invM);
+  const float ds = channelShare * ((diffS * diffS - (vn + 0.25f * (mp + mm))) * invS);
+  plus += dp <= clamp ? dp : clamp;
+  minus += dm <= clamp ? dm : clamp;
+  sym += ds <= clamp ? ds : clamp;
+}
+
 ROW_KERNEL
 void addColorDistances(int n, const float* __restrict g, const float* __restrict gp,
                        const float* __restrict gm, const float* __restrict vn,
@@ -132,28 +152,22 @@ void addColorDistances(int n, const float* __restrict g, const float* __restrict
                        float* __restrict plus, float* __restrict minus, float* __restrict sym,
                        float* __restrict sPlus, float* __restrict sMinus, float* __restrict sSym) {
   const float clamp = kClamp * channelShare;
-  for (int i = 0; i < n; ++i) {
-    const float mp = std::min(vn[i], vnp[i]), mm = std::min(vn[i], vnm[i]);
-    const float diffP = g[i] - gp[i], diffM = g[i] - gm[i];
-    const float diffS = g[i] - 0.5f * (gp[i] + gm[i]);
-    const float invP = 1.0f / (vd[i] + vdp[i] + kEpsilon);
-    const float invM = 1.0f / (vd[i] + vdm[i] + kEpsilon);
-    const float invS = 1.0f / (vd[i] + neighbourShare * (vdp[i] + vdm[i]) + kEpsilon);
-    const float dp = channelShare * ((diffP * diffP - (vn[i] + mp)) * invP);
-    const float dm = channelShare * ((diffM * diffM - (vn[i] + mm)) * invM);
-    const float ds = channelShare * ((diffS * diffS - (vn[i] + 0.25f * (mp + mm))) * invS);
-    plus[i] += dp <= clamp ? dp : clamp;
-    minus[i] += dm <= clamp ? dm : clamp;
-    sym[i] += ds <= clamp ? ds : clamp;
+  float invP, invM, invS;
+  if (!sPlus) {
+    for (int i = 0; i < n; ++i)
+      colorDistances(g[i], gp[i], gm[i], vn[i], vnp[i], vnm[i], vd[i], vdp[i], vdm[i],
+                     channelShare, neighbourShare, clamp, plus[i], minus[i], sym[i], invP, invM,
+                     invS);
+    return;
   }
-  if (!sPlus) return;
   for (int i = 0; i < n; ++i) {
+    colorDistances(g[i], gp[i], gm[i], vn[i], vnp[i], vnm[i], vd[i], vdp[i], vdm[i], channelShare,
+                   neighbourShare, clamp, plus[i], minus[i], sym[i], invP, invM, invS);
     // d/dg(p) of diff² · inv = 2 diff · inv
-    const float diffP = g[i] - gp[i], diffM = g[i] - gm[i];
-    const float diffS = g[i] - 0.5f * (gp[i] + gm[i]);
-    sPlus[i] = 2.0f * channelShare * diffP / (vd[i] + vdp[i] + kEpsilon);
-    sMinus[i] = 2.0f * channelShare * diffM / (vd[i] + vdm[i] + kEpsilon);
-    sSym[i] = 2.0f * channelShare * diffS / (vd[i] + neighbourShare * (vdp[i] + vdm[i]) + kEpsilon);
+    const float twice = 2.0f * channelShare;
+    sPlus[i] = twice * (g[i] - gp[i]) * invP;
+    sMinus[i] = twice * (g[i] - gm[i]) * invM;
+    sSym[i] = twice * (g[i] - 0.5f * (gp[i] + gm[i])) * invS;
   }
 }
 

@@ -2,8 +2,10 @@
 // The inner loops of the NL-means filters with feature terms (feature_nlmeans.cpp,
 // rdfc_candidates.cpp): one call processes one row segment of n pixels for one window offset δ.
 // Every loop is branch-free over contiguous arrays so that it vectorises; validity (neighbours
-// outside the image) comes in as 0/1 masks. The kernels are compiled for AVX2 and for the baseline
-// architecture (the loader picks one); neither uses FMA, so both give bit-identical results.
+// outside the image) comes in as 0/1 masks. The kernels are compiled for AVX-512F, AVX2 and the
+// baseline architecture (CHORUS_SIMD_CLONES; the loader picks one). The AVX-512F build contracts
+// a·b + c into FMAs, so its results may differ from the others' in the last bit; each machine
+// always runs the same build, so results stay deterministic there.
 //
 // Conventions: `p` arrays hold the centre pixels' values, `q` / `qp` / `qm` the values at p + δ /
 // p + δ / p − δ (pointers into zero-padded planes). "num" variances are α V, "den" variances

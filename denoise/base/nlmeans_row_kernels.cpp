@@ -123,18 +123,16 @@ void featureTermWeights(int n, int channels, size_t planeStride, const float* f,
   }
 }
 
-// One pixel's colour distances (addColorDistances); the reciprocals of the denominators are
-// returned for the slopes.
+// One pixel's colour distances (addColorDistances).
 inline void colorDistances(float g, float gp, float gm, float vn, float vnp, float vnm, float vd,
                            float vdp, float vdm, float channelShare, float neighbourShare,
-                           float clamp, float& plus, float& minus, float& sym, float& invP,
-                           float& invM, float& invS) {
+                           float clamp, float& plus, float& minus, float& sym) {
   const float mp = std::min(vn, vnp), mm = std::min(vn, vnm);
   const float diffP = g - gp, diffM = g - gm;
   const float diffS = g - 0.5f * (gp + gm);
-  invP = 1.0f / (vd + vdp + kEpsilon);
-  invM = 1.0f / (vd + vdm + kEpsilon);
-  invS = 1.0f / (vd + neighbourShare * (vdp + vdm) + kEpsilon);
+  const float invP = 1.0f / (vd + vdp + kEpsilon);
+  const float invM = 1.0f / (vd + vdm + kEpsilon);
+  const float invS = 1.0f / (vd + neighbourShare * (vdp + vdm) + kEpsilon);
   const float dp = channelShare * ((diffP * diffP - (vn + mp)) * invP);
   const float dm = channelShare * ((diffM * diffM - (vn + mm)) * invM);
   const float ds = channelShare * ((diffS * diffS - (vn + 0.25f * (mp + mm))) * invS);
@@ -152,22 +150,23 @@ void addColorDistances(int n, const float* __restrict g, const float* __restrict
                        float* __restrict plus, float* __restrict minus, float* __restrict sym,
                        float* __restrict sPlus, float* __restrict sMinus, float* __restrict sSym) {
   const float clamp = kClamp * channelShare;
-  float invP, invM, invS;
   if (!sPlus) {
     for (int i = 0; i < n; ++i)
       colorDistances(g[i], gp[i], gm[i], vn[i], vnp[i], vnm[i], vd[i], vdp[i], vdm[i],
-                     channelShare, neighbourShare, clamp, plus[i], minus[i], sym[i], invP, invM,
-                     invS);
+                     channelShare, neighbourShare, clamp, plus[i], minus[i], sym[i]);
     return;
   }
+  // With the slopes in the same loop (one pass over the planes). They divide rather than reuse
+  // the reciprocals above: a last-bit change of a derivative can flip RDFC's selection.
+  const float twice = 2.0f * channelShare;
   for (int i = 0; i < n; ++i) {
     colorDistances(g[i], gp[i], gm[i], vn[i], vnp[i], vnm[i], vd[i], vdp[i], vdm[i], channelShare,
-                   neighbourShare, clamp, plus[i], minus[i], sym[i], invP, invM, invS);
+                   neighbourShare, clamp, plus[i], minus[i], sym[i]);
     // d/dg(p) of diff² · inv = 2 diff · inv
-    const float twice = 2.0f * channelShare;
-    sPlus[i] = twice * (g[i] - gp[i]) * invP;
-    sMinus[i] = twice * (g[i] - gm[i]) * invM;
-    sSym[i] = twice * (g[i] - 0.5f * (gp[i] + gm[i])) * invS;
+    sPlus[i] = twice * (g[i] - gp[i]) / (vd[i] + vdp[i] + kEpsilon);
+    sMinus[i] = twice * (g[i] - gm[i]) / (vd[i] + vdm[i] + kEpsilon);
+    sSym[i] = twice * (g[i] - 0.5f * (gp[i] + gm[i])) /
+              (vd[i] + neighbourShare * (vdp[i] + vdm[i]) + kEpsilon);
   }
 }
 

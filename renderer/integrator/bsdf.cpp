@@ -81,7 +81,9 @@ Bsdf::Bsdf(const MaterialPoint& material) : m_(material) {
   // specular = 0 removes the layer (and with metallic = 0 leaves a plain Lambertian, which then
   // skips all microfacet work).
   roughReflection_ = !smooth_ && (m_.metallic > 0 || m_.specular > 0);
-  lambertian_ = m_.metallic == 0 && m_.specular == 0 && m_.transmission == 0;
+  // A black one scatters nothing and takes the general path, which says so.
+  lambertian_ =
+      m_.metallic == 0 && m_.specular == 0 && m_.transmission == 0 && m_.baseColor.average() > 0;
 
   // KHR_materials_specular: f0 = min(f0(ior) · specularColor, 1) · specular, f90 = specular.
   const float f0Ior = f0FromIor(eta_);
@@ -140,7 +142,7 @@ Bsdf::Context Bsdf::context(Vec3f wo) const {
   c.wo = c.flip ? mirrorZ(wo) : wo;
   if (lambertian_) {
     // What the general path below reduces to, without its Fresnel and layer-albedo terms.
-    if (m_.baseColor.average() > 0) c.weights.diffuse = 1.0f;
+    c.weights.diffuse = 1.0f;
     return c;
   }
   if (!c.inside) c.layerAlbedoO = layerAlbedo(c.wo.z);
@@ -260,7 +262,7 @@ BsdfEval Bsdf::evaluate(Vec3f wo, Vec3f wi) const {
   if (!grazingSafe(wo) || !grazingSafe(wi)) return {};
   if (lambertian_) {
     // evalCanonical's diffuse term, reflection only (the lobe weight is 1, or 0 when black).
-    if ((wo.z < 0) != (wi.z < 0) || !(m_.baseColor.average() > 0)) return {};
+    if ((wo.z < 0) != (wi.z < 0)) return {};
     return {m_.baseColor * kInvPi, cosineHemispherePdfSolidAngle(std::abs(wi.z))};
   }
   const Context c = context(wo);
@@ -279,7 +281,6 @@ std::optional<BsdfSample> Bsdf::sample(Vec3f woAsGiven, float uLobe, Vec2f u) co
   if (!grazingSafe(woAsGiven) || !finiteInputs(woAsGiven, uLobe, u)) return std::nullopt;
   if (lambertian_) {
     // The diffuse branch below, without the lobe choice and the general evaluation.
-    if (!(m_.baseColor.average() > 0)) return std::nullopt;
     const Vec3f wi = sampleCosineHemisphere(u);
     if (!grazingSafe(wi)) return std::nullopt;
     const float pdf = cosineHemispherePdfSolidAngle(wi.z);

@@ -102,7 +102,7 @@ class Bsdf {
   SpecularAlbedoRow layerAlbedoRow_;  // rough with a specular layer only
   bool smooth_ = false;
   bool roughReflection_ = false;    // a rough metal or specular-layer lobe exists
-  bool lambertian_ = false;         // only the diffuse lobe, with nothing layered on it
+  bool lambertian_ = false;         // only a non-black diffuse lobe, nothing layered on it
   bool purelySpecular_ = false;     // isPurelySpecular()
   bool transmits_ = false;          // hasTransmission()
   bool solidTransmission_ = false;  // refracts into a closed volume (wo.z < 0 is inside)

@@ -17,12 +17,6 @@ Rgb meanEmission(const MaterialDesc& m, const SceneData& data) {
          Rgb(image.meanSrgbDecoded[0], image.meanSrgbDecoded[1], image.meanSrgbDecoded[2]);
 }
 
-float triangleArea(const MeshDesc& mesh, uint32_t primID) {
-  const uint32_t* idx = &mesh.indices[3 * size_t(primID)];
-  return 0.5f * length(cross(mesh.positions[idx[1]] - mesh.positions[idx[0]],
-                             mesh.positions[idx[2]] - mesh.positions[idx[0]]));
-}
-
 // The side every point of a triangle faces, when it is the same everywhere: the face normal
 // turned toward the vertex normals (Scene::interaction's rule), which cannot change across the
 // triangle when all three vertex normals lie on one side of it. Zero otherwise.
@@ -80,22 +74,21 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene), environment_(scene.envi
     const Rgb meanLe = meanEmission(m, data);
     const float sides = m.doubleSided ? 2.0f : 1.0f;
     for (uint32_t primID = 0; primID < sm.mesh.triangleCount(); ++primID) {
-      const float area = triangleArea(sm.mesh, primID);
       AreaLight light;
       light.geomID = uint32_t(geomID);
       light.primID = primID;
-      light.area = area;
       const uint32_t* idx = &sm.mesh.indices[3 * size_t(primID)];
       light.p0 = sm.mesh.positions[idx[0]];
       light.p1 = sm.mesh.positions[idx[1]];
       light.p2 = sm.mesh.positions[idx[2]];
+      light.area = 0.5f * length(cross(light.p1 - light.p0, light.p2 - light.p0));
       light.normal = uniformOrientation(sm, primID);
       light.uniform = m.emissiveTexture < 0 && lengthSquared(light.normal) > 0;
       light.doubleSided = m.doubleSided;
       light.Le = m.emissive;
       areaLights_.push_back(light);
       lights_.push_back({Kind::Area, uint32_t(areaLights_.size() - 1)});
-      power.push_back(kPi * sides * area * meanLe.luminance());
+      power.push_back(kPi * sides * light.area * meanLe.luminance());
     }
   }
   for (size_t i = 0; i < data.punctualLights.size(); ++i) {

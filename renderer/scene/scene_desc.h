@@ -96,9 +96,7 @@ struct MaterialDesc {
            specularTexture >= 0 || specularColorTexture >= 0;
   }
   bool usesTextures() const {
-    return baseColorTexture >= 0 || metallicRoughnessTexture >= 0 || normalTexture >= 0 ||
-           emissiveTexture >= 0 || transmissionTexture >= 0 || specularTexture >= 0 ||
-           specularColorTexture >= 0;
+    return hasBsdfTextures() || normalTexture >= 0 || emissiveTexture >= 0;
   }
 };
 

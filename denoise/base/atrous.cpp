@@ -7,6 +7,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "denoise/base/atrous_kernel.h"
@@ -257,59 +258,64 @@ void atrousLevel(const Guide& g, const AtrousParams& params, AtrousKernelPath pa
   });
 }
 
-// Which pixels are demodulated: all but those near a pixel whose albedo is (nearly) black in
-// every channel. With the chorus renderer's features an emitter seen directly records its
-// material's albedo (black for a pure light), so its radiance divided by the albedo floor is
-// enormous, and pixels that mix emitter and surface samples take huge demodulated values and
-// variances that leak into their neighbours (measured on the Cornell box: relMSE ×6 at 64
-// spp). Filtering those pixels as radiance avoids it; Tungsten instead records 1 + emission
-// as an emitter's albedo, which has the same effect. The guard square is dilated separably.
-std::vector<char> demodulationMask(const SubBuffer& buffer) {
+inline float finiteOrZero(float v) {
+  return std::isfinite(v) ? v : 0.0f;
+}
+
+// Demodulation divisors, interleaved RGB like the albedo: max(albedo, 1e-3) (non-finite albedo
+// counts as 0) — except near a pixel whose albedo is (nearly) black in every channel, where they
+// are 1. With the chorus renderer's features an emitter seen directly records its material's
+// albedo (black for a pure light), so its radiance divided by the albedo floor is enormous, and
+// pixels that mix emitter and surface samples take huge demodulated values and variances that
+// leak into their neighbours (measured on the Cornell box: relMSE ×6 at 64 spp). Filtering those
+// pixels as radiance avoids it; Tungsten instead records 1 + emission as an emitter's albedo,
+// which has the same effect. The guard square is dilated separably. Computed once per run: the
+// demodulation and the remodulation both read them.
+std::vector<float> demodulationDivisors(const SubBuffer& buffer, bool demodulate) {
   const int w = buffer.width(), h = buffer.height();
+  const size_t pixels = size_t(w) * size_t(h);
+  std::vector<float> divisors(pixels * 3);
+  if (!demodulate) {
+    std::fill(divisors.begin(), divisors.end(), 1.0f);
+    return divisors;
+  }
   const float* albedo = buffer.albedo.mean.data();
   // nearBlack: some pixel within kEmitterGuard columns on the same row is black.
-  std::vector<char> nearBlack(size_t(w) * size_t(h)), mask(size_t(w) * size_t(h));
+  std::vector<char> nearBlack(pixels);
   tbb::parallel_for(0, h, [&](int y) {
-    std::vector<char> black(static_cast<size_t>(w));
+    std::vector<char> black(size_t(w) + 2 * kEmitterGuard, 0);  // with a guard band each side
+    const float* a = albedo + size_t(y) * size_t(w) * 3;
     for (int x = 0; x < w; ++x) {
-      const float* a = albedo + (size_t(y) * size_t(w) + size_t(x)) * 3;
-      float brightest = 0;  // non-finite channels count as 0
-      for (int c = 0; c < 3; ++c)
-        brightest = std::isfinite(a[c]) && a[c] > brightest ? a[c] : brightest;
-      black[size_t(x)] = brightest < kEmitterAlbedo;
+      const float brightest = std::max(std::max(0.0f, finiteOrZero(a[3 * x])),
+                                       std::max(finiteOrZero(a[3 * x + 1]), finiteOrZero(a[3 * x + 2])));
+      black[size_t(x + kEmitterGuard)] = brightest < kEmitterAlbedo;
     }
     char* row = nearBlack.data() + size_t(y) * size_t(w);
     for (int x = 0; x < w; ++x) {
       char near = 0;
-      for (int qx = std::max(0, x - kEmitterGuard); qx <= std::min(w - 1, x + kEmitterGuard); ++qx)
-        near |= black[size_t(qx)];
+      for (int d = 0; d <= 2 * kEmitterGuard; ++d) near |= black[size_t(x + d)];
       row[x] = near;
     }
   });
   tbb::parallel_for(0, h, [&](int y) {
-    char* row = mask.data() + size_t(y) * size_t(w);
-    std::fill(row, row + w, char(1));
-    for (int qy = std::max(0, y - kEmitterGuard); qy <= std::min(h - 1, y + kEmitterGuard); ++qy) {
-      const char* near = nearBlack.data() + size_t(qy) * size_t(w);
-      for (int x = 0; x < w; ++x) row[x] &= char(!near[x]);
+    const char* near[2 * kEmitterGuard + 1];
+    int rows = 0;
+    for (int qy = std::max(0, y - kEmitterGuard); qy <= std::min(h - 1, y + kEmitterGuard); ++qy)
+      near[rows++] = nearBlack.data() + size_t(qy) * size_t(w);
+    const size_t first = size_t(y) * size_t(w);
+    const float* a = albedo + first * 3;
+    float* out = divisors.data() + first * 3;
+    for (int x = 0; x < w; ++x) {
+      char guarded = 0;
+      for (int r = 0; r < rows; ++r) guarded |= near[r][x];
+      for (int c = 0; c < 3; ++c) {
+        const float v = a[3 * x + c];
+        const float floored = std::isfinite(v) ? std::max(v, kAlbedoFloor) : kAlbedoFloor;
+        out[3 * x + c] = guarded ? 1.0f : floored;
+      }
     }
   });
-  return mask;
-}
-
-// Row y's demodulation divisors, interleaved RGB: max(albedo, 1e-3) (non-finite albedo counts
-// as 0) where the mask demodulates, else 1.
-void demodulationDivisors(const SubBuffer& buffer, const std::vector<char>& demodulated, int y,
-                          std::vector<float>& divisors) {
-  const int w = buffer.width();
-  const size_t first = size_t(y) * size_t(w);
-  const float* albedo = buffer.albedo.mean.data() + first * 3;
-  for (int x = 0; x < w; ++x)
-    for (int c = 0; c < 3; ++c) {
-      const size_t e = size_t(3 * x + c);
-      const float a = std::isfinite(albedo[e]) ? std::max(albedo[e], kAlbedoFloor) : kAlbedoFloor;
-      divisors[e] = demodulated[first + size_t(x)] ? a : 1.0f;
-    }
+  return divisors;
 }
 
 }  // namespace
@@ -318,29 +324,24 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKerne
   const int w = buffer.width(), h = buffer.height();
   const float* color = buffer.color.mean.data();
   const float* colorVariance = buffer.color.varianceOfMean.data();
-  // Demodulation: pixels within `kEmitterGuard` pixels of one whose albedo is below
-  // kEmitterAlbedo are filtered as radiance (see demodulationMask).
-  const std::vector<char> demodulated =
-      params.demodulate ? demodulationMask(buffer) : std::vector<char>(size_t(w) * size_t(h), 0);
+  const std::vector<float> divisors = demodulationDivisors(buffer, params.demodulate);
   // Taps reach 2·2^(iterations−1) pixels past the borders: zero margins that wide.
   const int margin = 1 << params.iterations;
   // Demodulate; luminance variance (Σ a_c √V_c)², V_c of the demodulated colour.
   PaddedPlanes state(w, h, kStatePlanes, margin);
   tbb::parallel_for(0, h, [&](int y) {
-    std::vector<float> divisors(size_t(3 * w));
-    demodulationDivisors(buffer, demodulated, y, divisors);
     const size_t first = size_t(y) * size_t(w) * 3, o = state.index(0, y);
+    const float *m = color + first, *v = colorVariance + first, *d = divisors.data() + first;
     float* rgb[3] = {state.plane(kRed) + o, state.plane(kGreen) + o, state.plane(kBlue) + o};
     float* variance = state.plane(kVariance) + o;
     for (int x = 0; x < w; ++x) {
       float deviation = 0;
       for (int c = 0; c < 3; ++c) {
         const size_t e = size_t(3 * x + c);
-        const float inverse = 1.0f / divisors[e], m = color[first + e],
-                    v = colorVariance[first + e];
-        rgb[c][x] = (std::isfinite(m) ? m : 0.0f) * inverse;
-        deviation +=
-            kLuminance[size_t(c)] * std::sqrt(std::isfinite(v) && v > 0 ? v : 0.0f) * inverse;
+        const float inverse = 1.0f / d[e];
+        rgb[c][x] = finiteOrZero(m[e]) * inverse;
+        const float positive = v[e] > 0 && v[e] <= std::numeric_limits<float>::max() ? v[e] : 0.0f;
+        deviation += kLuminance[size_t(c)] * std::sqrt(positive) * inverse;
       }
       variance[x] = deviation * deviation;
     }
@@ -359,15 +360,12 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKerne
   // Remodulate.
   Image out(w, h, 3);
   tbb::parallel_for(0, h, [&](int y) {
-    std::vector<float> divisors(size_t(3 * w));
-    demodulationDivisors(buffer, demodulated, y, divisors);
-    float* row = out.data() + size_t(y) * size_t(w) * 3;
-    const size_t o = state.index(0, y);
+    const size_t first = size_t(y) * size_t(w) * 3, o = state.index(0, y);
+    const float* d = divisors.data() + first;
+    float* row = out.data() + first;
     for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c) {
-        const float v = state.plane(kRed + c)[o + size_t(x)] * divisors[size_t(3 * x + c)];
-        row[3 * x + c] = std::isfinite(v) ? v : 0.0f;
-      }
+      for (int c = 0; c < 3; ++c)
+        row[3 * x + c] = finiteOrZero(state.plane(kRed + c)[o + size_t(x)] * d[3 * x + c]);
   });
   return out;
 }

@@ -43,6 +43,7 @@
 #include "renderer/scene/gltf_loader.h"
 #include "tests/support/synthetic_scene.h"
 #include "tools/sweep/reference_render.h"
+#include "denoise/util/memory_reuse.h"
 
 namespace chorus::bench {
 namespace {
@@ -304,6 +305,7 @@ void run(const BenchOptions& o) {
 }  // namespace chorus::bench
 
 int main(int argc, char** argv) {
+  chorus::reuseFreedMemory();
   chorus::bench::BenchOptions o;
   CLI::App app{"Seconds per megapixel and relMSE of every registered base denoiser"};
   app.add_option("--cases", o.cases, "case sources: synthetic, rendered, peers (comma-separated)");

@@ -25,6 +25,7 @@
 #include "denoise/ensemble/synthetic_cases.h"
 #include "denoise/metrics/metrics.h"
 #include "denoise/util/stopwatch.h"
+#include "denoise/util/memory_reuse.h"
 
 namespace {
 using namespace chorus;
@@ -111,6 +112,7 @@ Timing timeWeightFilter(const CombineResult& result, const EnsembleGuides& guide
 }  // namespace
 
 int main(int argc, char** argv) {
+  chorus::reuseFreedMemory();
   CLI::App app{"ensemble combination step: seconds per megapixel"};
   int size = 1024, threads = 2, repeats = 3;
   std::string only;

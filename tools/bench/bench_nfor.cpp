@@ -24,6 +24,7 @@
 #include "denoise/image/exr_io.h"
 #include "denoise/metrics/metrics.h"
 #include "denoise/util/error.h"
+#include "denoise/util/memory_reuse.h"
 
 namespace chorus {
 namespace {
@@ -169,6 +170,7 @@ int run(int argc, char** argv) {
 }  // namespace chorus
 
 int main(int argc, char** argv) {
+  chorus::reuseFreedMemory();
   try {
     return chorus::run(argc, argv);
   } catch (const std::exception& e) {

@@ -23,6 +23,7 @@
 #include "renderer/scene/gltf_loader.h"
 #include "tools/chorus/render_denoise.h"
 #include "tools/sweep/reference_render.h"
+#include "denoise/util/memory_reuse.h"
 
 namespace {
 
@@ -46,8 +47,8 @@ Run runOnce(const render::Scene& scene, const render::RenderOptions& options,
   const double cpu0 = cpuSeconds();
   Stopwatch total, stage;
   render::RenderResult rendered = render::render(scene, options);
-  const EnsembleSources sources = sourcesFromBuffers(rendered.buffers);
-  rendered.buffers = {};
+  const EnsembleSources sources =
+      sourcesFromBuffers(std::move(rendered.buffers), readsHalves(ensemble.members()));
   run.render = stage.restart();
   const EnsembleResult result = ensemble.run(sources);
   for (const StageTime& t : result.times)
@@ -65,6 +66,7 @@ Run runOnce(const render::Scene& scene, const render::RenderOptions& options,
 }  // namespace
 
 int main(int argc, char** argv) {
+  chorus::reuseFreedMemory();
   CLI::App app("Preview latency and quality: render + preview ensemble, end to end");
   std::string scenePath = "scenes/cornell-box.gltf", preview = cli::kPreviewDenoise,
               full = cli::kDefaultDenoise, cache;

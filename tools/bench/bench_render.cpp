@@ -31,6 +31,7 @@
 #include "renderer/render.h"
 #include "renderer/sampling/warps.h"
 #include "renderer/scene/gltf_loader.h"
+#include "denoise/util/memory_reuse.h"
 
 namespace {
 
@@ -159,6 +160,7 @@ bool peer(int size, int spp, int threads) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  chorus::reuseFreedMemory();
   CLI::App app{
       "bench_render: chorus renderer throughput against Embree's tutorial path tracer and raw "
       "Embree, and peak memory"};

@@ -6,6 +6,7 @@
 
 #include "denoise/util/error.h"
 #include "tools/chorus/command.h"
+#include "denoise/util/memory_reuse.h"
 
 namespace chorus::cli {
 
@@ -30,6 +31,7 @@ void addAllCommands(CLI::App& app) {
 }  // namespace chorus::cli
 
 int main(int argc, char** argv) {
+  chorus::reuseFreedMemory();
   using namespace chorus::cli;
   CLI::App app{
       "chorus: a glTF path tracer with integrated ensemble denoising.\n"

@@ -125,6 +125,45 @@ TEST(EnsembleRunner, HalvesOfTheirOwnInputNeedFourSubBuffers) {
   EXPECT_THROW(Ensemble(boxMembers(), {}).run(buffers(1)), Error);
 }
 
+// Taking the buffers over gives the same inputs as copying them (every image of every part),
+// and leaves the full input's halves out only when asked to.
+TEST(EnsembleRunner, SourcesTakenOverEqualSourcesCopied) {
+  const auto sameSub = [](const SubBuffer& x, const SubBuffer& y) {
+    for (Quantity q : kAllQuantities)
+      if (!sameImage(x.get(q).mean, y.get(q).mean) ||
+          !sameImage(x.get(q).varianceOfMean, y.get(q).varianceOfMean))
+        return false;
+    return sameImage(x.sampleCount, y.sampleCount);
+  };
+  for (int splits : {2, 4})
+    for (bool halvesOfFull : {true, false}) {
+      SCOPED_TRACE("K = " + std::to_string(splits) + (halvesOfFull ? ", halves" : ", none"));
+      SampleBuffers taken = buffers(splits);
+      const EnsembleSources copied = sourcesFromBuffers(taken);
+      const EnsembleSources moved = sourcesFromBuffers(std::move(taken), halvesOfFull);
+      EXPECT_EQ(taken.splitCount(), 0);
+      EXPECT_TRUE(sameSub(moved.a.whole, copied.a.whole));
+      EXPECT_TRUE(sameSub(moved.b.whole, copied.b.whole));
+      EXPECT_TRUE(sameSub(moved.full.whole, copied.full.whole));
+      EXPECT_EQ(moved.a.halves.has_value(), splits == 4);
+      if (splits == 4) {
+        EXPECT_TRUE(sameSub((*moved.a.halves)[1], (*copied.a.halves)[1]));
+      }
+      ASSERT_EQ(moved.full.halves.has_value(), halvesOfFull);
+      if (halvesOfFull) {
+        EXPECT_TRUE(sameSub((*moved.full.halves)[0], (*copied.full.halves)[0]));
+        EXPECT_TRUE(sameSub((*moved.full.halves)[1], (*copied.full.halves)[1]));
+      }
+    }
+  // Which members read halves: NFOR-like ones need them, joint NL-means uses them when present.
+  std::vector<EnsembleMember> members = boxMembers();
+  EXPECT_FALSE(readsHalves(members));
+  members.push_back({"halves", std::make_shared<HalvesDenoiser>()});
+  EXPECT_TRUE(readsHalves(members));
+  EXPECT_TRUE(readsHalves(membersFromSpecs(std::vector<std::string>{"atrous", "jnlm"})));
+  EXPECT_FALSE(readsHalves(membersFromSpecs(std::vector<std::string>{"atrous", "bilateral"})));
+}
+
 TEST(EnsembleRunner, RejectsBadMemberLists) {
   EXPECT_THROW(Ensemble({}, {}).run(buffers(4)), Error);
   std::vector<EnsembleMember> twice = {{"box", std::make_shared<BoxDenoiser>(1)},

@@ -12,6 +12,7 @@ namespace chorus {
 struct DenoiserRequirements {
   bool features = false;  // reads albedo / normal / depth / visibility
   bool halves = false;    // needs DenoiseInput::halves (two independent halves of its input)
+  bool readsHalves = false;  // uses DenoiseInput::halves when present (without needing them)
 };
 
 class BaseDenoiser {

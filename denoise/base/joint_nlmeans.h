@@ -42,7 +42,7 @@ class JointNlMeans : public BaseDenoiser {
   explicit JointNlMeans(JointNlMeansParams params = {}) : params_(params) {}
   std::string name() const override { return "jnlm"; }
   // Uses halves when present but does not need them.
-  DenoiserRequirements requirements() const override { return {.features = true, .halves = false}; }
+  DenoiserRequirements requirements() const override { return {.features = true, .halves = false, .readsHalves = true}; }
   Image run(const DenoiseInput& input) const override { return runJointNlMeans(input, params_); }
 
  private:

@@ -46,6 +46,14 @@ int splitsNeeded(std::span<const EnsembleMember> members) {
   return 2;
 }
 
+bool readsHalves(std::span<const EnsembleMember> members) {
+  for (const EnsembleMember& member : members) {
+    const DenoiserRequirements r = member.denoiser->requirements();
+    if (r.halves || r.readsHalves) return true;
+  }
+  return false;
+}
+
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
                                           std::vector<StageTime>* times) {

@@ -35,6 +35,10 @@ void checkMembersCanRun(const EnsembleSources& sources, std::span<const Ensemble
 // ensemble's halves A and B). Fewer sub-buffers mean less film to fill and merge.
 int splitsNeeded(std::span<const EnsembleMember> members);
 
+// Whether some member needs or reads the halves of its input (else sourcesFromBuffers can leave
+// the full input's halves out: two copies of the render less).
+bool readsHalves(std::span<const EnsembleMember> members);
+
 // Every member on sources.a, .b and .full, in parallel. Appends "<label>/A", "<label>/B",
 // "<label>/full" (the time of each run) and "bases" (wall time of all of them) to `times`.
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,

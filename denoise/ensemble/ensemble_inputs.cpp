@@ -33,6 +33,22 @@ EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers) {
   return sources;
 }
 
+EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull) {
+  if (buffers.splitCount() != 2) {
+    EnsembleSources sources = sourcesFromBuffers(buffers);
+    if (!halvesOfFull) sources.full.halves.reset();
+    buffers = {};
+    return sources;
+  }
+  EnsembleSources sources;
+  sources.full.whole = buffers.part(BufferPart::Full);
+  if (halvesOfFull) sources.full.halves = std::array<SubBuffer, 2>{buffers.sub(0), buffers.sub(1)};
+  sources.a.whole = std::move(buffers.sub(0));
+  sources.b.whole = std::move(buffers.sub(1));
+  buffers = {};
+  return sources;
+}
+
 EnsembleSources sourcesFromHalves(const DenoiseInput& input) {
   if (!input.halves) throw Error("the ensemble needs two independent halves of the input");
   EnsembleSources sources;

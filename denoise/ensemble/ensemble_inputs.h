@@ -41,6 +41,11 @@ struct EnsembleSources {
 // none. Throws chorus::Error for an odd K.
 EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers);
 
+// The same, taking the sub-buffers over (K = 2: they become a and b instead of being copied;
+// `buffers` is left empty). Without `halvesOfFull`, full.halves stays empty (for members that
+// never read it: see readsHalves in ensemble.h).
+EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull);
+
 // From an input with two halves (e.g. a Tungsten directory): a = halves[0], b = halves[1]
 // (without halves of their own), full = the input. Throws chorus::Error without halves.
 EnsembleSources sourcesFromHalves(const DenoiseInput& input);

@@ -113,9 +113,13 @@ void runRender(RenderArgs args) {
   ensureDirectory(out);
   nlohmann::ordered_json stats = statsJson(args, result.stats, loaded);
   // The denoisers' inputs are copies, so the buffers can move into render.exr's layers (no
-  // second copy of a large render in memory), and render.exr is on disk before denoising.
+  // second copy of a large render in memory), and render.exr is on disk before denoising. A
+  // preview writes no render.exr: its inputs take the buffers over.
   std::optional<EnsembleSources> sources;
-  if (denoise.enabled()) sources = sourcesFromBuffers(result.buffers);
+  if (denoise.enabled())
+    sources = args.preview
+                  ? sourcesFromBuffers(std::move(result.buffers), readsHalves(denoise.members))
+                  : sourcesFromBuffers(result.buffers);
   std::string written;
   const Stopwatch write;
   if (!args.preview) {

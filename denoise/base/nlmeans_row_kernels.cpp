@@ -301,20 +301,77 @@ void nearColorSlopes(int n, const float* __restrict g, const float* __restrict g
   }
 }
 
+// The candidate kernels take their many row pointers in structs: copied to locals, with ivdep
+// (the rows of one call never overlap) so that GCC vectorises without alias checks.
 ROW_KERNEL
-void colorCandidateWeights(int n, const float* __restrict dPlus, const float* __restrict dMinus,
-                           const float* __restrict dSym, const float* __restrict invCountPlus,
-                           const float* __restrict invCountMinus,
-                           const float* __restrict invCountSym, const float* __restrict maskPlus,
-                           const float* __restrict maskMinus, const float* __restrict maskSym,
-                           float minRefineWeight, const float* __restrict fPlus,
-                           const float* __restrict fMinus, const float* __restrict maxWeight,
-                           float* __restrict vPlus, float* __restrict vMinus, float* __restrict tw1,
-                           float* __restrict tw2, float* __restrict tws, float* __restrict tk1,
-                           float* __restrict tk2, float* __restrict tks, float* __restrict ta,
-                           float* __restrict tsum, float* __restrict tinv, float* __restrict tp1,
-                           float* __restrict tp2, float* __restrict tq1, float* __restrict tq2) {
+void accumulateCandidate(int n, const float* __restrict wPlus, const float* __restrict wMinus,
+                         const CandidateSums& sums) {
+  const float* up[6];
+  const float* um[6];
+  for (int k = 0; k < 6; ++k) {
+    up[k] = sums.dataPlus[k];
+    um[k] = sums.dataMinus[k];
+  }
+  float* __restrict weightSum = sums.weightSum;
+  float* __restrict maxWeight = sums.maxWeight;
+  float* __restrict acc = sums.acc;
+  const size_t stride = sums.accStride;
+#pragma GCC ivdep
   for (int i = 0; i < n; ++i) {
+    const float v1 = wPlus[i], v2 = wMinus[i];
+    weightSum[i] += v1 + v2;
+    maxWeight[i] = std::max(maxWeight[i], std::max(v1, v2));
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k) {
+      float& a = acc[size_t(k) * stride + size_t(i)];
+      a += v1 * up[k][i] + v2 * um[k][i];
+    }
+  }
+}
+
+template <bool Near>
+ROW_KERNEL void accumulateColorCandidateOf(int n, const ColorCandidateRow& row,
+                                           float minRefineWeight, const CandidateSums& sums) {
+  const float* dPlus = row.dist[0];
+  const float* dMinus = row.dist[1];
+  const float* dSym = row.dist[2];
+  const float* invCountPlus = row.invCount[0];
+  const float* invCountMinus = row.invCount[1];
+  const float* invCountSym = row.invCount[2];
+  const float* maskPlus = row.mask[0];
+  const float* maskMinus = row.mask[1];
+  const float* maskSym = row.mask[2];
+  const float* fPlus = row.featPlus;
+  const float* fMinus = row.featMinus;
+  const float* slope[3][3];
+  const float* nearSlope[3][3];
+  const float* gPlus[3];
+  const float* gMinus[3];
+  for (int c = 0; c < 3; ++c) {
+    for (int kind = 0; kind < 3; ++kind) {
+      slope[c][kind] = row.slope[c][kind];
+      nearSlope[c][kind] = Near ? row.nearSlope[c][kind] : nullptr;
+    }
+    gPlus[c] = row.guidePlus[c];
+    gMinus[c] = row.guideMinus[c];
+  }
+  float* __restrict derivativeSum = row.derivativeSum;
+  float* __restrict derivativeAcc = row.derivativeAcc;
+  float* __restrict maxDerivative = row.maxDerivative;
+  const size_t dStride = row.derivativeStride;
+  const float* up[6];
+  const float* um[6];
+  for (int k = 0; k < 6; ++k) {
+    up[k] = sums.dataPlus[k];
+    um[k] = sums.dataMinus[k];
+  }
+  float* __restrict weightSum = sums.weightSum;
+  float* __restrict maxWeight = sums.maxWeight;
+  float* __restrict acc = sums.acc;
+  const size_t stride = sums.accStride;
+#pragma GCC ivdep
+  for (int i = 0; i < n; ++i) {
+    // The weights and the terms of their derivatives.
     const float w1 = maskPlus[i] * weightOf(dPlus[i]), w2 = maskMinus[i] * weightOf(dMinus[i]);
     const float ws = weightOf(dSym[i]);
     const float sum = w1 + w2, t = ws / sum - 1.0f;
@@ -324,47 +381,49 @@ void colorCandidateWeights(int n, const float* __restrict dPlus, const float* __
     const float m = maxWeight[i];
     const float pick2 = float((v2 > m) & (v2 > v1));
     const float inv = 1.0f / (sum * sum + 1e-30f);  // finite; sum ≥ 2e^−25 where refining
-    vPlus[i] = v1;
-    vMinus[i] = v2;
-    tw1[i] = w1;
-    tw2[i] = w2;
-    tws[i] = ws;
-    tk1[i] = -w1 * invCountPlus[i] * float(dPlus[i] > 0.0f);
-    tk2[i] = -w2 * invCountMinus[i] * float(dMinus[i] > 0.0f);
-    tks[i] = -ws * invCountSym[i] * float(dSym[i] > 0.0f);
-    ta[i] = a;
-    tsum[i] = sum;
-    tinv[i] = float((a > 0.0f) & (t < 1.0f)) * inv;
-    tp1[i] = float(r1 < fPlus[i]);
-    tp2[i] = float(r2 < fMinus[i]);
-    tq1[i] = float(v1 > m) * (1.0f - pick2);
-    tq2[i] = pick2;
+    // ∂w / ∂D · (1 / patch count): −w where 0 < D < 87, else 0
+    const float k1 = -w1 * invCountPlus[i] * float(dPlus[i] > 0.0f);
+    const float k2 = -w2 * invCountMinus[i] * float(dMinus[i] > 0.0f);
+    const float ks = -ws * invCountSym[i] * float(dSym[i] > 0.0f);
+    const float invSum2 = float((a > 0.0f) & (t < 1.0f)) * inv;  // where a ∈ (0, 1)
+    const float pass1 = float(r1 < fPlus[i]), pass2 = float(r2 < fMinus[i]);
+    const float pick1 = float(v1 > m) * (1.0f - pick2);
+    // Their derivatives with respect to each channel of y(p), against the maximum before δ.
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; ++c) {
+      float sp = slope[c][0][i], sm = slope[c][1][i], ss = slope[c][2][i];
+      if constexpr (Near) {
+        sp = sp + nearSlope[c][0][i];
+        sm = sm + nearSlope[c][1][i];
+        ss = ss + nearSlope[c][2][i];
+      }
+      const float dw1 = k1 * sp, dw2 = k2 * sm;
+      const float dws = ks * ss;
+      const float da = (dws * sum - ws * (dw1 + dw2)) * invSum2;
+      const float dv1 = pass1 * (da * (ws - w1) + a * dws + (1.0f - a) * dw1);
+      const float dv2 = pass2 * (da * (ws - w2) + a * dws + (1.0f - a) * dw2);
+      const size_t k = size_t(c) * dStride + size_t(i);
+      derivativeSum[k] += dv1 + dv2;
+      derivativeAcc[k] += dv1 * gPlus[c][i] + dv2 * gMinus[c][i];
+      maxDerivative[k] = pick2 * dv2 + pick1 * dv1 + (1.0f - pick1 - pick2) * maxDerivative[k];
+    }
+    // The sums.
+    weightSum[i] += v1 + v2;
+    maxWeight[i] = std::max(maxWeight[i], std::max(v1, v2));
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k) {
+      float& s = acc[size_t(k) * stride + size_t(i)];
+      s += v1 * up[k][i] + v2 * um[k][i];
+    }
   }
 }
 
-ROW_KERNEL
-void accumulateColorDerivative(int n, const float* __restrict tw1, const float* __restrict tw2,
-                               const float* __restrict tws, const float* __restrict tk1,
-                               const float* __restrict tk2, const float* __restrict tks,
-                               const float* __restrict ta, const float* __restrict tsum,
-                               const float* __restrict tinv, const float* __restrict tp1,
-                               const float* __restrict tp2, const float* __restrict tq1,
-                               const float* __restrict tq2, const float* __restrict slopePlus,
-                               const float* __restrict slopeMinus, const float* __restrict slopeSym,
-                               const float* __restrict gPlus, const float* __restrict gMinus,
-                               float* __restrict derivativeSum, float* __restrict derivativeAcc,
-                               float* __restrict maxDerivative) {
-  for (int i = 0; i < n; ++i) {
-    const float dw1 = tk1[i] * slopePlus[i], dw2 = tk2[i] * slopeMinus[i];
-    const float dws = tks[i] * slopeSym[i];
-    const float a = ta[i], ws = tws[i];
-    const float da = (dws * tsum[i] - ws * (dw1 + dw2)) * tinv[i];
-    const float dv1 = tp1[i] * (da * (ws - tw1[i]) + a * dws + (1.0f - a) * dw1);
-    const float dv2 = tp2[i] * (da * (ws - tw2[i]) + a * dws + (1.0f - a) * dw2);
-    derivativeSum[i] += dv1 + dv2;
-    derivativeAcc[i] += dv1 * gPlus[i] + dv2 * gMinus[i];
-    maxDerivative[i] = tq2[i] * dv2 + tq1[i] * dv1 + (1.0f - tq1[i] - tq2[i]) * maxDerivative[i];
-  }
+void accumulateColorCandidate(int n, const ColorCandidateRow& row, float minRefineWeight,
+                              const CandidateSums& sums) {
+  if (row.nearSlope[0][0])
+    accumulateColorCandidateOf<true>(n, row, minRefineWeight, sums);
+  else
+    accumulateColorCandidateOf<false>(n, row, minRefineWeight, sums);
 }
 
 ROW_KERNEL

@@ -80,60 +80,47 @@ void nearColorSlopes(int n, const float* g, const float* gp, const float* gm, co
                      const float* maskMinusPair, const float* maskBehind, const float* maskAhead,
                      float* nearPlus, float* nearMinus, float* nearSym);
 
-// Per-pixel quantities of one colour candidate's weights for one offset pair ±δ, kept for the
-// derivative pass (row arrays of n values each).
-struct ColorWeightTerms {
-  float *w1, *w2, *ws;  // colour weights exp(−max(0, D)) for δ, −δ and the symmetric pair
-  float *k1, *k2, *ks;  // ∂w / ∂D · (1 / patch count): −w where 0 < D < 87, else 0
-  float *a, *sum, *invSum2;  // refinement factor, w1 + w2, 1 / (w1 + w2)² where a ∈ (0, 1)
-  float *pass1, *pass2;      // 1 where the colour weight is below the feature weight
-  float *pick1, *pick2;      // 1 where this weight becomes the running maximum
+// One row of an RDFC candidate's running sums (rdfc_candidates.cpp): Σw, max w and Σ w u for
+// six data planes (b1 and b2, RGB), the planes `accStride` floats apart.
+struct CandidateSums {
+  const float* dataPlus[6];   // the data at p + δ
+  const float* dataMinus[6];  // the data at p − δ
+  float* weightSum;
+  float* maxWeight;
+  float* acc;
+  size_t accStride;
 };
 
-// Weights v = min(refined colour weight, feature weight) for δ and −δ into vPlus / vMinus, and
-// the terms of their derivatives (one output array per ColorWeightTerms field: separate
-// restrict-qualified arguments, which GCC needs to vectorise the loop). maxWeight is the running
-// maximum before this offset.
-void colorCandidateWeights(int n, const float* dPlus, const float* dMinus, const float* dSym,
-                           const float* invCountPlus, const float* invCountMinus,
-                           const float* invCountSym, const float* maskPlus, const float* maskMinus,
-                           const float* maskSym, float minRefineWeight, const float* fPlus,
-                           const float* fMinus, const float* maxWeight, float* vPlus, float* vMinus,
-                           float* w1, float* w2, float* ws, float* k1, float* k2, float* ks,
-                           float* a, float* sum, float* invSum2, float* pass1, float* pass2,
-                           float* pick1, float* pick2);
-inline void colorCandidateWeights(int n, const float* dPlus, const float* dMinus, const float* dSym,
-                                  const float* invCountPlus, const float* invCountMinus,
-                                  const float* invCountSym, const float* maskPlus,
-                                  const float* maskMinus, const float* maskSym,
-                                  float minRefineWeight, const float* fPlus, const float* fMinus,
-                                  const float* maxWeight, float* vPlus, float* vMinus,
-                                  const ColorWeightTerms& t) {
-  colorCandidateWeights(n, dPlus, dMinus, dSym, invCountPlus, invCountMinus, invCountSym, maskPlus,
-                        maskMinus, maskSym, minRefineWeight, fPlus, fMinus, maxWeight, vPlus,
-                        vMinus, t.w1, t.w2, t.ws, t.k1, t.k2, t.ks, t.a, t.sum, t.invSum2, t.pass1,
-                        t.pass2, t.pick1, t.pick2);
-}
+// Σw, max w and Σ w u of a candidate whose weights are given (THIRD: the feature weights).
+void accumulateCandidate(int n, const float* wPlus, const float* wMinus, const CandidateSums& sums);
 
-// Exact derivative of those weights with respect to one channel of y(p), from the slopes of the
-// channel's distances: through exp(−max(0, D)), the symmetric refinement
-// a = clamp(ws / (w1 + w2) − 1, 0, 1) and the minimum (one-sided at the kinks). Adds Σ ∂v and
-// Σ ∂v y(p ± δ) and follows the derivative of the running maximum.
-void accumulateColorDerivative(int n, const float* w1, const float* w2, const float* ws,
-                               const float* k1, const float* k2, const float* ks, const float* a,
-                               const float* sum, const float* invSum2, const float* pass1,
-                               const float* pass2, const float* pick1, const float* pick2,
-                               const float* slopePlus, const float* slopeMinus,
-                               const float* slopeSym, const float* gPlus, const float* gMinus,
-                               float* derivativeSum, float* derivativeAcc, float* maxDerivative);
-inline void accumulateColorDerivative(int n, const ColorWeightTerms& t, const float* slopePlus,
-                                      const float* slopeMinus, const float* slopeSym,
-                                      const float* gPlus, const float* gMinus, float* derivativeSum,
-                                      float* derivativeAcc, float* maxDerivative) {
-  accumulateColorDerivative(n, t.w1, t.w2, t.ws, t.k1, t.k2, t.ks, t.a, t.sum, t.invSum2, t.pass1,
-                            t.pass2, t.pick1, t.pick2, slopePlus, slopeMinus, slopeSym, gPlus,
-                            gMinus, derivativeSum, derivativeAcc, maxDerivative);
-}
+// One row of a colour candidate (FIRST, SECOND) for one offset pair ±δ.
+struct ColorCandidateRow {
+  const float* dist[3];      // patch-mean colour distances for δ, −δ and the symmetric pair
+  const float* invCount[3];  // 1 / patch count of each
+  const float* mask[3];      // 1 where the pair exists
+  const float* featPlus;     // feature weights for δ, −δ
+  const float* featMinus;
+  // Per channel c of y(p): slopes of the pixel distances (δ, −δ, symmetric) where p is the centre,
+  // and where p is a neighbour in its own patch (null when δ lies outside the patch).
+  const float* slope[3][3];
+  const float* nearSlope[3][3];
+  const float* guidePlus[3];  // y_c(p + δ), y_c(p − δ)
+  const float* guideMinus[3];
+  // Per channel planes, `derivativeStride` floats apart: Σ ∂v, Σ ∂v y(q), ∂(max w).
+  float* derivativeSum;
+  float* derivativeAcc;
+  float* maxDerivative;
+  size_t derivativeStride;
+};
+
+// Weights v = min(refined colour weight exp(−max(0, D)), feature weight) for δ and −δ, their
+// exact derivatives with respect to each channel of y(p) — through the exponential, the
+// symmetric refinement a = clamp(ws / (w1 + w2) − 1, 0, 1) and the minimum (one-sided at the
+// kinks), following the running maximum — and the candidate's sums, in one pass (the
+// per-pixel terms stay in registers instead of a row array each).
+void accumulateColorCandidate(int n, const ColorCandidateRow& row, float minRefineWeight,
+                              const CandidateSums& sums);
 
 // Σw and max w.
 void accumulateWeightSums(int n, const float* wPlus, const float* wMinus, float* weightSum,

@@ -34,10 +34,7 @@ struct TileMemory {
   std::vector<float> ext[3];                     // colour pixel distances over the grown tile
   std::vector<float> rowSums, invCountX;         // box filter: horizontal sums, 1 / x counts
   std::vector<float> dist[kColor][3], invCount[kColor][3];
-  std::vector<float> slope[3][3], nearSlope[3][3], combined[3];  // [channel][kind]
-  std::vector<float> wPlus, wMinus;
-  std::vector<float> termStore[13];  // rows of rows::ColorWeightTerms
-  rows::ColorWeightTerms terms;
+  std::vector<float> slope[3][3], nearSlope[3][3];  // [channel][kind]
   // Accumulators, per candidate: Σw, max w, Σ w b1 (3 planes), Σ w b2 (3 planes); per colour
   // candidate and channel of y(p): Σ ∂w, Σ ∂w y(q), ∂(max w).
   std::vector<float> weightSum[3], maxWeight[3], acc[3];
@@ -267,59 +264,48 @@ void CandidateKernel::accumulate(const PixelRect& tile, int dx, int dy, TileMemo
   const int adx = std::abs(dx), ady = std::abs(dy);
   for (int y = tile.y0; y < tile.y1; ++y) {
     const size_t row = size_t(y - tile.y0) * size_t(tw);
-    const float* dataPlus[6];
-    const float* dataMinus[6];
+    rows::CandidateSums sums;
     for (int c = 0; c < 3; ++c) {
-      dataPlus[c] = b1_.row(c, y + dy) + x0 + dx;
-      dataPlus[3 + c] = b2_.row(c, y + dy) + x0 + dx;
-      dataMinus[c] = b1_.row(c, y - dy) + x0 - dx;
-      dataMinus[3 + c] = b2_.row(c, y - dy) + x0 - dx;
+      sums.dataPlus[c] = b1_.row(c, y + dy) + x0 + dx;
+      sums.dataPlus[3 + c] = b2_.row(c, y + dy) + x0 + dx;
+      sums.dataMinus[c] = b1_.row(c, y - dy) + x0 - dx;
+      sums.dataMinus[3 + c] = b2_.row(c, y - dy) + x0 - dx;
     }
-    auto accumulateCandidate = [&](int s, const float* wPlus, const float* wMinus) {
-      rows::accumulateWeightSums(tw, wPlus, wMinus, m.weightSum[s].data() + row,
-                                 m.maxWeight[s].data() + row);
-      for (int k = 0; k < 6; ++k)
-        rows::accumulateData(tw, wPlus, wMinus, dataPlus[k], dataMinus[k],
-                             m.acc[s].data() + size_t(k) * area + row);
+    sums.accStride = area;
+    auto candidateSums = [&](int s) {
+      sums.weightSum = m.weightSum[s].data() + row;
+      sums.maxWeight = m.maxWeight[s].data() + row;
+      sums.acc = m.acc[s].data() + row;
+      return sums;
     };
     // THIRD: the feature weights alone.
-    accumulateCandidate(2, m.featPlus[1].data() + row, m.featMinus[1].data() + row);
+    rows::accumulateCandidate(tw, m.featPlus[1].data() + row, m.featMinus[1].data() + row,
+                              candidateSums(2));
 
     for (int s = 0; s < kColor; ++s) {
-      const float* d[3] = {m.dist[s][kPlus].data() + row, m.dist[s][kMinus].data() + row,
-                           m.dist[s][kSym].data() + row};
-      const float* masks[3] = {m.mask[kPlus].data() + row, m.mask[kMinus].data() + row,
-                               m.mask[kSym].data() + row};
-      const float* fPlus = m.featPlus[0].data() + row;
-      const float* fMinus = m.featMinus[0].data() + row;
-      // Weights, then their derivatives with respect to each channel of y(p) (against the
-      // running maximum before this offset), then the sums.
-      rows::colorCandidateWeights(
-          tw, d[kPlus], d[kMinus], d[kSym], m.invCount[s][kPlus].data() + row,
-          m.invCount[s][kMinus].data() + row, m.invCount[s][kSym].data() + row, masks[kPlus],
-          masks[kMinus], masks[kSym], refineMinWeight_, fPlus, fMinus, m.maxWeight[s].data() + row,
-          m.wPlus.data(), m.wMinus.data(), m.terms);
+      rows::ColorCandidateRow r;
+      for (int kind = 0; kind < 3; ++kind) {
+        r.dist[kind] = m.dist[s][kind].data() + row;
+        r.invCount[kind] = m.invCount[s][kind].data() + row;
+        r.mask[kind] = m.mask[kind].data() + row;
+      }
+      r.featPlus = m.featPlus[0].data() + row;
+      r.featMinus = m.featMinus[0].data() + row;
+      // p is also a neighbour in its own patch sums for offsets within the patch.
       const bool near = adx <= patch_[s] && ady <= patch_[s];
       for (int c = 0; c < 3; ++c) {
-        const float* slope[3];
         for (int kind = 0; kind < 3; ++kind) {
-          const float* centre = m.slope[c][kind].data() + row;
-          if (!near) {
-            slope[kind] = centre;
-            continue;
-          }
-          const float* nearby = m.nearSlope[c][kind].data() + row;
-          float* sum = m.combined[kind].data();
-          for (int i = 0; i < tw; ++i) sum[i] = centre[i] + nearby[i];
-          slope[kind] = sum;
+          r.slope[c][kind] = m.slope[c][kind].data() + row;
+          r.nearSlope[c][kind] = near ? m.nearSlope[c][kind].data() + row : nullptr;
         }
-        const size_t k = size_t(c) * area + row;
-        rows::accumulateColorDerivative(
-            tw, m.terms, slope[kPlus], slope[kMinus], slope[kSym], g_.row(c, y + dy) + x0 + dx,
-            g_.row(c, y - dy) + x0 - dx, m.derivativeSum[s].data() + k,
-            m.derivativeAcc[s].data() + k, m.maxDerivative[s].data() + k);
+        r.guidePlus[c] = g_.row(c, y + dy) + x0 + dx;
+        r.guideMinus[c] = g_.row(c, y - dy) + x0 - dx;
       }
-      accumulateCandidate(s, m.wPlus.data(), m.wMinus.data());
+      r.derivativeSum = m.derivativeSum[s].data() + row;
+      r.derivativeAcc = m.derivativeAcc[s].data() + row;
+      r.maxDerivative = m.maxDerivative[s].data() + row;
+      r.derivativeStride = area;
+      rows::accumulateColorCandidate(tw, r, refineMinWeight_, candidateSums(s));
     }
   }
 }
@@ -384,15 +370,6 @@ void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out
       m.slope[c][kind].resize(area);
       m.nearSlope[c][kind].resize(area);
     }
-  for (auto& v : m.combined) v.resize(kTileWidth);
-  m.wPlus.resize(kTileWidth);
-  m.wMinus.resize(kTileWidth);
-  for (auto& v : m.termStore) v.resize(kTileWidth);
-  float** fields[13] = {&m.terms.w1,      &m.terms.w2,    &m.terms.ws,    &m.terms.k1,
-                        &m.terms.k2,      &m.terms.ks,    &m.terms.a,     &m.terms.sum,
-                        &m.terms.invSum2, &m.terms.pass1, &m.terms.pass2, &m.terms.pick1,
-                        &m.terms.pick2};
-  for (int f = 0; f < 13; ++f) *fields[f] = m.termStore[f].data();
   for (int s = 0; s < 3; ++s) {
     m.weightSum[s].assign(area, 0.0f);
     m.maxWeight[s].assign(area, 0.0f);

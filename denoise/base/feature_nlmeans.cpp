@@ -53,8 +53,11 @@ void boxMean(const float* src, const PixelRect& in, float* dst, const PixelRect&
 }
 
 struct TileMemory {
-  std::vector<float> mask[3], featPlus, featMinus, termRow[3];
-  std::vector<float> ext[3], dist[3], gridMask[3], gridPlus, gridMinus, rowSums, invX;
+  std::vector<float> maskStore[3], featPlus, featMinus, termRow[3];
+  std::vector<float> ones;        // a mask where every pair exists
+  const float* mask[3] = {};      // this offset's validity masks over the tile
+  const float* gridMask[3] = {};  // ... over the grid
+  std::vector<float> ext[3], dist[3], gridMaskStore[3], gridPlus, gridMinus, rowSums, invX;
   std::vector<float> patchPlus, patchMinus, wPlus, wMinus;
   std::vector<float> weightSum, maxWeight;
   std::vector<float> acc;  // every data channel, one plane each
@@ -188,14 +191,14 @@ void FeatureNlMeansKernel::featureWeights(const PixelRect& tile, int dx, int dy,
       }
       const float scale = 1.0f / float(termBegin_[term + 1] - termBegin_[term]);
       rows::minTermWeights(tw, scale, m.termRow[kPlus].data(), m.termRow[kMinus].data(),
-                           m.termRow[kSym].data(), m.mask[kSym].data() + row, refineMinWeight_,
+                           m.termRow[kSym].data(), m.mask[kSym] + row, refineMinWeight_,
                            m.featPlus.data() + row, m.featMinus.data() + row);
     }
   }
-  for (size_t i = 0; i < area; ++i) {
-    m.featPlus[i] *= m.mask[kPlus][i];
-    m.featMinus[i] *= m.mask[kMinus][i];
-  }
+  if (m.mask[kPlus] != m.ones.data())
+    for (size_t i = 0; i < area; ++i) m.featPlus[i] *= m.mask[kPlus][i];
+  if (m.mask[kMinus] != m.ones.data())
+    for (size_t i = 0; i < area; ++i) m.featMinus[i] *= m.mask[kMinus][i];
 }
 
 void FeatureNlMeansKernel::unrefinedFeatureWeights(const PixelRect& tile, int dx, int dy,
@@ -224,8 +227,8 @@ void FeatureNlMeansKernel::unrefinedFeatureWeights(const PixelRect& tile, int dx
       rows::maxScaled(tw, scale, m.termRow[kPlus].data(), maxPlus);
       rows::maxScaled(tw, scale, m.termRow[kMinus].data(), maxMinus);
     }
-    rows::maskedWeights(tw, maxPlus, m.mask[kPlus].data() + row, m.featPlus.data() + row);
-    rows::maskedWeights(tw, maxMinus, m.mask[kMinus].data() + row, maxMinus);
+    rows::maskedWeights(tw, maxPlus, m.mask[kPlus] + row, m.featPlus.data() + row);
+    rows::maskedWeights(tw, maxMinus, m.mask[kMinus] + row, maxMinus);
   }
 }
 
@@ -235,7 +238,6 @@ void FeatureNlMeansKernel::patchWeights(const PixelRect& tile, int dx, int dy,
   const PixelRect grid = tile.grown(box_), ext = grid.grown(f_);
   const int ew = ext.width(), gw = grid.width();
   const size_t eArea = size_t(ext.area());
-  for (auto& e : m.ext) std::fill(e.begin(), e.begin() + ptrdiff_t(eArea), 0.0f);
   const float share = 1.0f / float(patchChannels_);
   const int ox = ext.x0;
   for (int y = ext.y0; y < ext.y1; ++y) {
@@ -247,26 +249,26 @@ void FeatureNlMeansKernel::patchWeights(const PixelRect& tile, int dx, int dy,
           vn_.row(c, y) + ox, vn_.row(c, y + dy) + ox + dx, vn_.row(c, y - dy) + ox - dx, vd,
           patchCentreOnly_ ? vd : vd_.row(c, y + dy) + ox + dx,
           patchCentreOnly_ ? vd : vd_.row(c, y - dy) + ox - dx, share,
-          patchCentreOnly_ ? 0.5f : 0.25f, m.ext[kPlus].data() + e, m.ext[kMinus].data() + e,
-          m.ext[kSym].data() + e, nullptr, nullptr, nullptr);
+          patchCentreOnly_ ? 0.5f : 0.25f, c == 0, m.ext[kPlus].data() + e,
+          m.ext[kMinus].data() + e, m.ext[kSym].data() + e, nullptr, nullptr, nullptr);
     }
   }
   // Patch means over the grid (the tile grown by the weight box), counting valid pixels only.
   for (int kind = 0; kind < 3; ++kind) {
     if (ext.intersect(valid.rect[kind]) != ext) {  // × 1 changes nothing (not even a NaN)
-      fillRectMask(ext, valid.rect[kind], m.gridMask[kind].data());  // scratch: the ext mask
-      for (size_t i = 0; i < eArea; ++i) m.ext[kind][i] *= m.gridMask[kind][i];
+      fillRectMask(ext, valid.rect[kind], m.gridMaskStore[kind].data());  // scratch: ext mask
+      for (size_t i = 0; i < eArea; ++i) m.ext[kind][i] *= m.gridMaskStore[kind][i];
     }
     boxMean(m.ext[kind].data(), ext, m.dist[kind].data(), grid, f_, valid.rect[kind], m.rowSums,
             m.invX);
-    fillRectMask(grid, valid.rect[kind], m.gridMask[kind].data());
+    m.gridMask[kind] = rectMaskOrOnes(grid, valid.rect[kind], m.gridMaskStore[kind], m.ones.data());
   }
   for (int y = grid.y0; y < grid.y1; ++y) {
     const size_t r = size_t(y - grid.y0) * size_t(gw);
     rows::patchWeights(gw, m.dist[kPlus].data() + r, m.dist[kMinus].data() + r,
-                       m.dist[kSym].data() + r, m.gridMask[kPlus].data() + r,
-                       m.gridMask[kMinus].data() + r, m.gridMask[kSym].data() + r, refineMinWeight_,
-                       m.gridPlus.data() + r, m.gridMinus.data() + r);
+                       m.dist[kSym].data() + r, m.gridMask[kPlus] + r, m.gridMask[kMinus] + r,
+                       m.gridMask[kSym] + r, refineMinWeight_, m.gridPlus.data() + r,
+                       m.gridMinus.data() + r);
   }
   // "Patchwise": the weights themselves box-filtered over the valid pixels.
   if (box_ > 0) {
@@ -289,11 +291,11 @@ void FeatureNlMeansKernel::runTile(const PixelRect& tile, TileMemory& m,
   const size_t gridArea = size_t(kTileWidth + 2 * box_) * size_t(kTileHeight + 2 * box_);
   const size_t extArea =
       size_t(kTileWidth + 2 * (box_ + f_)) * size_t(kTileHeight + 2 * (box_ + f_));
-  for (auto& v : m.mask) v.resize(area);
+  m.ones.assign(extArea, 1.0f);
   for (auto& v : m.termRow) v.resize(kTileWidth);
   for (auto& v : m.ext) v.resize(extArea);
   for (auto& v : m.dist) v.resize(gridArea);
-  for (auto& v : m.gridMask) v.resize(extArea);
+  for (auto& v : m.gridMaskStore) v.resize(extArea);
   for (auto* v : {&m.featPlus, &m.featMinus, &m.patchPlus, &m.patchMinus, &m.wPlus, &m.wMinus})
     v->resize(area);
   m.gridPlus.resize(gridArea);
@@ -306,16 +308,20 @@ void FeatureNlMeansKernel::runTile(const PixelRect& tile, TileMemory& m,
   for (int dy = 0; dy <= r; ++dy)
     for (int dx = dy == 0 ? 1 : -r; dx <= r; ++dx) {
       const ValidRects valid(width_, height_, dx, dy);
-      for (int kind = 0; kind < 3; ++kind) fillRectMask(tile, valid.rect[kind], m.mask[kind].data());
-      featureWeights(tile, dx, dy, m);
-      const float* wPlus = m.featPlus.data();
-      const float* wMinus = m.featMinus.data();
+      for (int kind = 0; kind < 3; ++kind)
+        m.mask[kind] = rectMaskOrOnes(tile, valid.rect[kind], m.maskStore[kind], m.ones.data());
+      // Without feature terms the feature weights are the masks (1 × mask).
+      const float* wPlus = m.mask[kPlus];
+      const float* wMinus = m.mask[kMinus];
+      if (termBegin_.size() > 1) {
+        featureWeights(tile, dx, dy, m);
+        wPlus = m.featPlus.data();
+        wMinus = m.featMinus.data();
+      }
       if (hasPatch_) {
         patchWeights(tile, dx, dy, m);
-        for (size_t i = 0; i < area; ++i) {
-          m.wPlus[i] = std::min(m.patchPlus[i], m.featPlus[i]);
-          m.wMinus[i] = std::min(m.patchMinus[i], m.featMinus[i]);
-        }
+        rows::minWeights(int(area), m.patchPlus.data(), wPlus, m.wPlus.data());
+        rows::minWeights(int(area), m.patchMinus.data(), wMinus, m.wMinus.data());
         wPlus = m.wPlus.data();
         wMinus = m.wMinus.data();
       }

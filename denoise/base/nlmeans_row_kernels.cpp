@@ -147,10 +147,23 @@ void addColorDistances(int n, const float* __restrict g, const float* __restrict
                        const float* __restrict vnp, const float* __restrict vnm,
                        const float* __restrict vd, const float* __restrict vdp,
                        const float* __restrict vdm, float channelShare, float neighbourShare,
-                       float* __restrict plus, float* __restrict minus, float* __restrict sym,
-                       float* __restrict sPlus, float* __restrict sMinus, float* __restrict sSym) {
+                       bool first, float* __restrict plus, float* __restrict minus,
+                       float* __restrict sym, float* __restrict sPlus, float* __restrict sMinus,
+                       float* __restrict sSym) {
   const float clamp = kClamp * channelShare;
+  // The first channel adds to 0 rather than to the sums (which need no clearing then).
   if (!sPlus) {
+    if (first) {
+      for (int i = 0; i < n; ++i) {
+        float p = 0.0f, m = 0.0f, q = 0.0f;
+        colorDistances(g[i], gp[i], gm[i], vn[i], vnp[i], vnm[i], vd[i], vdp[i], vdm[i],
+                       channelShare, neighbourShare, clamp, p, m, q);
+        plus[i] = p;
+        minus[i] = m;
+        sym[i] = q;
+      }
+      return;
+    }
     for (int i = 0; i < n; ++i)
       colorDistances(g[i], gp[i], gm[i], vn[i], vnp[i], vnm[i], vd[i], vdp[i], vdm[i],
                      channelShare, neighbourShare, clamp, plus[i], minus[i], sym[i]);
@@ -159,6 +172,21 @@ void addColorDistances(int n, const float* __restrict g, const float* __restrict
   // With the slopes in the same loop (one pass over the planes). They divide rather than reuse
   // the reciprocals above: a last-bit change of a derivative can flip RDFC's selection.
   const float twice = 2.0f * channelShare;
+  if (first) {
+    for (int i = 0; i < n; ++i) {
+      float p = 0.0f, m = 0.0f, q = 0.0f;
+      colorDistances(g[i], gp[i], gm[i], vn[i], vnp[i], vnm[i], vd[i], vdp[i], vdm[i], channelShare,
+                     neighbourShare, clamp, p, m, q);
+      plus[i] = p;
+      minus[i] = m;
+      sym[i] = q;
+      sPlus[i] = twice * (g[i] - gp[i]) / (vd[i] + vdp[i] + kEpsilon);
+      sMinus[i] = twice * (g[i] - gm[i]) / (vd[i] + vdm[i] + kEpsilon);
+      sSym[i] = twice * (g[i] - 0.5f * (gp[i] + gm[i])) /
+                (vd[i] + neighbourShare * (vdp[i] + vdm[i]) + kEpsilon);
+    }
+    return;
+  }
   for (int i = 0; i < n; ++i) {
     colorDistances(g[i], gp[i], gm[i], vn[i], vnp[i], vnm[i], vd[i], vdp[i], vdm[i], channelShare,
                    neighbourShare, clamp, plus[i], minus[i], sym[i]);
@@ -249,6 +277,12 @@ void verticalBoxMean(int n, const float* __restrict src, size_t stride, int coun
     for (int i = 0; i < n; ++i) dst[i] += row[i];
   }
   for (int i = 0; i < n; ++i) dst[i] *= scaleY * scaleX[i];
+}
+
+ROW_KERNEL
+void minWeights(int n, const float* __restrict a, const float* __restrict b,
+                float* __restrict out) {
+  for (int i = 0; i < n; ++i) out[i] = std::min(a[i], b[i]);
 }
 
 ROW_KERNEL

@@ -37,11 +37,13 @@ void minTermWeights(int n, float scale, const float* dPlus, const float* dMinus,
 // patch-term pixel distances to p + δ, p − δ and to their mean, added to plus / minus / sym;
 // the symmetric denominator is vd + neighbourShare (vdp + vdm) (0.25; with vdp = vdm = vd and
 // 0.5, the centre-only 2 vd). With slope outputs (non-null), also their derivatives with respect
-// to g(p) (unclamped), written to sPlus / sMinus / sSym.
+// to g(p) (unclamped), written to sPlus / sMinus / sSym. `first`: the sums are written as
+// 0 + share (their old values are ignored) — the first channel, so that they need no clearing.
 void addColorDistances(int n, const float* g, const float* gp, const float* gm, const float* vn,
                        const float* vnp, const float* vnm, const float* vd, const float* vdp,
-                       const float* vdm, float channelShare, float neighbourShare, float* plus,
-                       float* minus, float* sym, float* sPlus, float* sMinus, float* sSym);
+                       const float* vdm, float channelShare, float neighbourShare, bool first,
+                       float* plus, float* minus, float* sym, float* sPlus, float* sMinus,
+                       float* sSym);
 
 // One feature channel's pixel distances (clamped) to p + δ, p − δ and to their mean, added to
 // plus / minus / sym, with one denominator set (symmetric: den + neighbourShare (denp + denm)).
@@ -58,6 +60,9 @@ void horizontalBoxSum(int n, const float* src, int r, float* dst);
 // turned into a box mean.
 void verticalBoxMean(int n, const float* src, size_t stride, int count, float scaleY,
                      const float* scaleX, float* dst);
+
+// out = min(a, b).
+void minWeights(int n, const float* a, const float* b, float* out);
 
 // dst = max(dst, scale · src).
 void maxScaled(int n, float scale, const float* src, float* dst);

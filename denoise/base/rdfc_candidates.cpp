@@ -29,7 +29,10 @@ constexpr int kColor = 2;                  // FIRST and SECOND have a colour ter
 enum Kind { kPlus, kMinus, kSym };
 
 struct TileMemory {
-  std::vector<float> mask[5];  // plus, minus, sym, behind (p−δ, p−2δ), ahead (p+δ, p+2δ)
+  // Validity masks of this offset: plus, minus, sym, behind (p−δ, p−2δ), ahead (p+δ, p+2δ);
+  // `ones` where every pixel of the tile has its pair.
+  std::vector<float> maskStore[5], ones;
+  const float* mask[5] = {};
   std::vector<float> featPlus[2], featMinus[2];  // feature weights, τ sets FIRST/SECOND, THIRD
   std::vector<float> ext[3];                     // colour pixel distances over the grown tile
   std::vector<float> rowSums, invCountX;         // box filter: horizontal sums, 1 / x counts
@@ -130,13 +133,11 @@ CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& 
 void CandidateKernel::masks(const PixelRect& tile, int dx, int dy, TileMemory& m) const {
   const PixelRect plus = neighbourInside(width_, height_, dx, dy);
   const PixelRect minus = neighbourInside(width_, height_, -dx, -dy);
-  fillRectMask(tile, plus, m.mask[kPlus].data());
-  fillRectMask(tile, minus, m.mask[kMinus].data());
-  fillRectMask(tile, plus.intersect(minus), m.mask[kSym].data());
-  fillRectMask(tile, minus.intersect(neighbourInside(width_, height_, -2 * dx, -2 * dy)),
-               m.mask[3].data());
-  fillRectMask(tile, plus.intersect(neighbourInside(width_, height_, 2 * dx, 2 * dy)),
-               m.mask[4].data());
+  const PixelRect valid[5] = {plus, minus, plus.intersect(minus),
+                              minus.intersect(neighbourInside(width_, height_, -2 * dx, -2 * dy)),
+                              plus.intersect(neighbourInside(width_, height_, 2 * dx, 2 * dy))};
+  for (int k = 0; k < 5; ++k)
+    m.mask[k] = rectMaskOrOnes(tile, valid[k], m.maskStore[k], m.ones.data());
 }
 
 void CandidateKernel::featureWeights(const PixelRect& tile, int dx, int dy, TileMemory& m) const {
@@ -156,23 +157,21 @@ void CandidateKernel::featureWeights(const PixelRect& tile, int dx, int dy, Tile
           fValue_.row(k, y + dy) + x0 + dx, fValue_.row(k, y - dy) + x0 - dx, fNum_.row(k, y) + x0,
           fNum_.row(k, y + dy) + x0 + dx, fNum_.row(k, y - dy) + x0 - dx, fDen_.row(k, y) + x0,
           fDen_.row(k, y + dy) + x0 + dx, fDen_.row(k, y - dy) + x0 - dx, termFloor_[0][term],
-          termFloor_[1][term], m.mask[kSym].data() + row, refineMinWeight_,
-          m.featPlus[0].data() + row, m.featMinus[0].data() + row, m.featPlus[1].data() + row,
-          m.featMinus[1].data() + row);
+          termFloor_[1][term], m.mask[kSym] + row, refineMinWeight_, m.featPlus[0].data() + row,
+          m.featMinus[0].data() + row, m.featPlus[1].data() + row, m.featMinus[1].data() + row);
     }
   }
-  for (int set = 0; set < 2; ++set)
-    for (size_t i = 0; i < area; ++i) {
-      m.featPlus[set][i] *= m.mask[kPlus][i];
-      m.featMinus[set][i] *= m.mask[kMinus][i];
-    }
+  for (int set = 0; set < 2; ++set) {
+    if (m.mask[kPlus] != m.ones.data())
+      for (size_t i = 0; i < area; ++i) m.featPlus[set][i] *= m.mask[kPlus][i];
+    if (m.mask[kMinus] != m.ones.data())
+      for (size_t i = 0; i < area; ++i) m.featMinus[set][i] *= m.mask[kMinus][i];
+  }
 }
 
 void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, TileMemory& m) const {
   const int tw = tile.width(), th = tile.height(), G = grow_;
   const int ex0 = tile.x0 - G, ey0 = tile.y0 - G, ew = tw + 2 * G, eh = th + 2 * G;
-  const size_t eArea = size_t(ew) * size_t(eh);
-  for (auto& e : m.ext) std::fill(e.begin(), e.begin() + ptrdiff_t(eArea), 0.0f);
   for (int ey = 0; ey < eh; ++ey) {
     const int y = ey0 + ey;
     const bool tileRow = y >= tile.y0 && y < tile.y1;
@@ -189,7 +188,7 @@ void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, Tile
             n, g_.row(c, y) + xa, g_.row(c, y + dy) + xa + dx, g_.row(c, y - dy) + xa - dx,
             vn_.row(c, y) + xa, vn_.row(c, y + dy) + xa + dx, vn_.row(c, y - dy) + xa - dx,
             vd_.row(c, y) + xa, vd_.row(c, y + dy) + xa + dx, vd_.row(c, y - dy) + xa - dx,
-            1.0f / 3.0f, 0.25f, m.ext[kPlus].data() + e, m.ext[kMinus].data() + e,
+            1.0f / 3.0f, 0.25f, c == 0, m.ext[kPlus].data() + e, m.ext[kMinus].data() + e,
             m.ext[kSym].data() + e, withSlope ? m.slope[c][kPlus].data() + t : nullptr,
             withSlope ? m.slope[c][kMinus].data() + t : nullptr,
             withSlope ? m.slope[c][kSym].data() + t : nullptr);
@@ -252,9 +251,9 @@ void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, Tile
           g_.row(c, y + 2 * dy) + x0 + 2 * dx, g_.row(c, y - 2 * dy) + x0 - 2 * dx,
           vd_.row(c, y) + x0, vd_.row(c, y + dy) + x0 + dx, vd_.row(c, y - dy) + x0 - dx,
           vd_.row(c, y + 2 * dy) + x0 + 2 * dx, vd_.row(c, y - 2 * dy) + x0 - 2 * dx,
-          m.mask[kPlus].data() + row, m.mask[kMinus].data() + row, m.mask[3].data() + row,
-          m.mask[4].data() + row, m.nearSlope[c][kPlus].data() + row,
-          m.nearSlope[c][kMinus].data() + row, m.nearSlope[c][kSym].data() + row);
+          m.mask[kPlus] + row, m.mask[kMinus] + row, m.mask[3] + row, m.mask[4] + row,
+          m.nearSlope[c][kPlus].data() + row, m.nearSlope[c][kMinus].data() + row,
+          m.nearSlope[c][kSym].data() + row);
   }
 }
 
@@ -287,7 +286,7 @@ void CandidateKernel::accumulate(const PixelRect& tile, int dx, int dy, TileMemo
       for (int kind = 0; kind < 3; ++kind) {
         r.dist[kind] = m.dist[s][kind].data() + row;
         r.invCount[kind] = m.invCount[s][kind].data() + row;
-        r.mask[kind] = m.mask[kind].data() + row;
+        r.mask[kind] = m.mask[kind] + row;
       }
       r.featPlus = m.featPlus[0].data() + row;
       r.featMinus = m.featMinus[0].data() + row;
@@ -352,7 +351,7 @@ void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out
   const FlushDenormals flush;  // tiny weights times data would be denormal
   const size_t area = size_t(tile.area());
   const size_t grownArea = size_t(kTileWidth + 2 * grow_) * size_t(kTileHeight + 2 * grow_);
-  for (auto& v : m.mask) v.resize(area);
+  m.ones.assign(area, 1.0f);
   for (int set = 0; set < 2; ++set) {
     m.featPlus[set].resize(area);
     m.featMinus[set].resize(area);

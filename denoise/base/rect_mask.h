@@ -3,6 +3,7 @@
 // neighbours exist form a rectangle of the image, so a mask is filled row by row instead of
 // testing every pixel.
 #include <algorithm>
+#include <vector>
 
 #include "denoise/base/filters/pixel_rect.h"
 
@@ -18,6 +19,17 @@ inline void fillRectMask(const PixelRect& area, const PixelRect& valid, float* m
     const int a = std::clamp(valid.x0 - area.x0, 0, w), b = std::clamp(valid.x1 - area.x0, 0, w);
     std::fill(row + a, row + std::max(a, b), 1.0f);
   }
+}
+
+// The mask of `valid` over `area`: `ones` (at least area.area() ones) where `area` lies inside
+// `valid` — most tiles and offsets; × 1 changes nothing, not even a NaN — else filled into
+// `storage`.
+inline const float* rectMaskOrOnes(const PixelRect& area, const PixelRect& valid,
+                                   std::vector<float>& storage, const float* ones) {
+  if (area.intersect(valid) == area) return ones;
+  storage.resize(size_t(area.area()));
+  fillRectMask(area, valid, storage.data());
+  return storage.data();
 }
 
 }  // namespace chorus

@@ -38,7 +38,9 @@ struct TileMemory {
   std::vector<float> featPlus[2], featMinus[2];  // feature weights, τ sets FIRST/SECOND, THIRD
   std::vector<float> ext[3];                     // colour pixel distances over the grown tile
   std::vector<float> rowSums, invCountX;         // box filter: horizontal sums, 1 / x counts
-  std::vector<float> dist[kColor][3], invCount[kColor][3];
+  std::vector<float> dist[kColor][3], invCountStore[kColor][3];
+  std::vector<float> fullInvCountX[kColor], fullInvCount[kColor];  // boxes inside the image
+  const float* invCount[kColor][3] = {};  // 1 / box counts of this offset
   std::vector<float> slope[3][3], nearSlope[3][3];  // [channel][kind]
   // Accumulators, per candidate: Σw, max w, Σ w b1 (3 planes), Σ w b2 (3 planes); per colour
   // candidate and channel of y(p): Σ ∂w, Σ ∂w y(q), ∂(max w).
@@ -217,27 +219,38 @@ void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, Tile
       std::fill(row + std::max(a, b), row + ew, 0.0f);
     }
 
-  // Patch means for both patch radii: box sums over the valid pixels × 1 / their count.
+  // Patch means for both patch radii: box sums over the valid pixels × 1 / their count. Where
+  // every box of the tile lies inside the valid pixels, the counts are those of the full patch
+  // (planes filled once per tile).
   for (int s = 0; s < kColor; ++s) {
     const int f = patch_[s];
     for (int kind = 0; kind < 3; ++kind) {
       const std::vector<float>& e = m.ext[kind];
-      for (int i = 0; i < tw; ++i) {
-        const int nx = boxOverlap(tile.x0 + i, f, loX[kind], hiX[kind]);
-        m.invCountX[size_t(i)] = nx > 0 ? 1.0f / float(nx) : 0.0f;
+      const bool full = tile.x0 - f >= loX[kind] && tile.x1 + f <= hiX[kind] &&
+                        tile.y0 - f >= loY[kind] && tile.y1 + f <= hiY[kind];
+      const float* invX = m.fullInvCountX[s].data();
+      if (!full) {
+        for (int i = 0; i < tw; ++i) {
+          const int nx = boxOverlap(tile.x0 + i, f, loX[kind], hiX[kind]);
+          m.invCountX[size_t(i)] = nx > 0 ? 1.0f / float(nx) : 0.0f;
+        }
+        invX = m.invCountX.data();
       }
       // Horizontal sums for the rows [tile.y0 − f, tile.y1 + f), tile columns.
       for (int y = tile.y0 - f; y < tile.y1 + f; ++y)
         rows::horizontalBoxSum(tw, e.data() + size_t(y - ey0) * size_t(ew) + size_t(tile.x0 - ex0),
                                f, m.rowSums.data() + size_t(y - tile.y0 + f) * size_t(tw));
+      m.invCount[s][kind] = full ? m.fullInvCount[s].data() : m.invCountStore[s][kind].data();
       for (int y = tile.y0; y < tile.y1; ++y) {
         const size_t row = size_t(y - tile.y0) * size_t(tw);
         const int ny = boxOverlap(y, f, loY[kind], hiY[kind]);
         const float invY = ny > 0 ? 1.0f / float(ny) : 0.0f;
-        float* inv = m.invCount[s][kind].data() + row;
-        for (int i = 0; i < tw; ++i) inv[i] = invY * m.invCountX[size_t(i)];
-        rows::verticalBoxMean(tw, m.rowSums.data() + row, size_t(tw), 2 * f + 1, invY,
-                              m.invCountX.data(), m.dist[s][kind].data() + row);
+        if (!full) {
+          float* inv = m.invCountStore[s][kind].data() + row;
+          for (int i = 0; i < tw; ++i) inv[i] = invY * invX[i];
+        }
+        rows::verticalBoxMean(tw, m.rowSums.data() + row, size_t(tw), 2 * f + 1, invY, invX,
+                              m.dist[s][kind].data() + row);
       }
     }
   }
@@ -287,7 +300,7 @@ void CandidateKernel::accumulate(const PixelRect& tile, int dx, int dy, TileMemo
       rows::ColorCandidateRow r;
       for (int kind = 0; kind < 3; ++kind) {
         r.dist[kind] = m.dist[s][kind].data() + row;
-        r.invCount[kind] = m.invCount[s][kind].data() + row;
+        r.invCount[kind] = m.invCount[s][kind] + row;
         r.mask[kind] = m.mask[kind] + row;
       }
       r.featPlus = m.featPlus[0].data() + row;
@@ -361,10 +374,15 @@ void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out
   for (auto& v : m.ext) v.resize(grownArea);
   m.rowSums.resize(size_t(kTileWidth) * size_t(kTileHeight + 2 * grow_));
   m.invCountX.resize(kTileWidth);
+  for (int s = 0; s < kColor; ++s) {
+    const float inv = 1.0f / float(2 * patch_[s] + 1);
+    m.fullInvCountX[s].assign(kTileWidth, inv);
+    m.fullInvCount[s].assign(area, inv * inv);
+  }
   for (int s = 0; s < kColor; ++s)
     for (int kind = 0; kind < 3; ++kind) {
       m.dist[s][kind].resize(area);
-      m.invCount[s][kind].resize(area);
+      m.invCountStore[s][kind].resize(area);
     }
   for (int c = 0; c < 3; ++c)
     for (int kind = 0; kind < 3; ++kind) {

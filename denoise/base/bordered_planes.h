@@ -3,6 +3,8 @@
 // a kernel may read any neighbour within `pad` pixels of the image without bounds checks.
 // Unlike PaddedPlanes (denoise/image/padded_planes.h: SIMD-aligned rows with horizontal margins
 // only, for à-trous), the border surrounds the image on all four sides.
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cstddef>
 #include <vector>
@@ -19,12 +21,13 @@ class BorderedPlanes {
         stride_(size_t(width + 2 * pad)),
         planeSize_(stride_ * size_t(height + 2 * pad)),
         data_(planeSize_ * size_t(channels), 0.0f) {}
-  // Channel c of this ← channel sourceChannel of image × scale.
+  // Channel c of this ← channel sourceChannel of image × scale (rows in parallel: the filters
+  // set up dozens of planes before their parallel loops).
   void set(int c, const Image& image, int sourceChannel, float scale = 1.0f) {
-    for (int y = 0; y < image.height(); ++y) {
+    tbb::parallel_for(0, image.height(), [&](int y) {
       float* row = mutableRow(c, y);
       for (int x = 0; x < image.width(); ++x) row[x] = scale * image(x, y, sourceChannel);
-    }
+    });
   }
   float* mutableRow(int c, int y) {
     return data_.data() + size_t(c) * planeSize_ + size_t(y + pad_) * stride_ + size_t(pad_);

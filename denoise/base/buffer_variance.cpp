@@ -1,5 +1,7 @@
 #include "denoise/base/buffer_variance.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -84,7 +86,7 @@ Image smooth3Tap(const Image& image, float sideWeight, const std::vector<uint8_t
   const int w = image.width(), h = image.height(), channels = image.channels();
   auto pass = [&](const Image& in, int sx, int sy) {
     Image out(w, h, channels);
-    for (int y = 0; y < h; ++y)
+    tbb::parallel_for(0, h, [&](int y) {
       for (int x = 0; x < w; ++x) {
         const size_t centre = size_t(y) * size_t(w) + size_t(x);
         for (int c = 0; c < channels; ++c) {
@@ -100,6 +102,7 @@ Image smooth3Tap(const Image& image, float sideWeight, const std::vector<uint8_t
           out(x, y, c) = weight > 0.0f ? sum / weight : 0.0f;
         }
       }
+    });
     return out;
   };
   const Image finite = finiteOr(image, 0.0f);

@@ -1,5 +1,7 @@
 #include "denoise/base/rdfc.h"
 
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <span>
 #include <string>
@@ -46,7 +48,7 @@ void selectCandidates(const Image& guide, const Image& variance, const RdfcParam
 
   result.selection = Image(w, h, 1);
   std::array<Image, 3> binary = {Image(w, h, 1), Image(w, h, 1), Image(w, h, 1)};
-  for (int y = 0; y < h; ++y)
+  tbb::parallel_for(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       auto meanDerivative = [&](int s) {
         const Image& d = result.candidates[size_t(s)].derivative;
@@ -64,6 +66,7 @@ void selectCandidates(const Image& guide, const Image& variance, const RdfcParam
       result.selection(x, y, 0) = float(best);
       binary[size_t(best)](x, y, 0) = 1.0f;
     }
+  });
 
   const Image* maps[] = {&binary[0], &binary[1], &binary[2]};
   std::vector<Image> soft = colorNlMeans(maps, guide, variance, params, params.selectionR);
@@ -74,7 +77,7 @@ void selectCandidates(const Image& guide, const Image& variance, const RdfcParam
 Image blendCandidates(const RdfcResult& result, Image RdfcCandidate::*buffer) {
   const Image& first = result.candidates[0].*buffer;
   Image out(first.width(), first.height(), 3);
-  for (int y = 0; y < out.height(); ++y)
+  tbb::parallel_for(0, out.height(), [&](int y) {
     for (int x = 0; x < out.width(); ++x) {
       float total = 0.0f;
       for (int s = 0; s < 3; ++s) total += result.selectionWeights[size_t(s)](x, y, 0);
@@ -88,6 +91,7 @@ Image blendCandidates(const RdfcResult& result, Image RdfcCandidate::*buffer) {
             total > 0.0f ? sum / total : (result.candidates[size_t(chosen)].*buffer)(x, y, c);
       }
     }
+  });
   return out;
 }
 

@@ -432,7 +432,7 @@ std::array<RdfcCandidate, 3> CandidateKernel::run() const {
     cand.derivative = std::move(out.derivative[size_t(s)]);
     cand.mean = Image(width_, height_, 3);
     cand.sure = Image(width_, height_, 1);
-    for (int y = 0; y < height_; ++y)
+    tbb::parallel_for(0, height_, [&](int y) {
       for (int x = 0; x < width_; ++x) {
         float sum = 0.0f;
         for (int c = 0; c < 3; ++c) {
@@ -442,6 +442,7 @@ std::array<RdfcCandidate, 3> CandidateKernel::run() const {
         }
         cand.sure(x, y, 0) = std::isfinite(sum) ? sum / 3.0f : std::numeric_limits<float>::max();
       }
+    });
   }
   return result;
 }

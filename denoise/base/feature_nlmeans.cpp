@@ -89,6 +89,7 @@ class FeatureNlMeansKernel {
   int f_ = 0, box_ = 0, patchChannels_ = 0;
   bool patchCentreOnly_ = false;
   BorderedPlanes g_, vn_, vd_;
+  BorderedPlanes invPair_, invSym_;  // centre-only: the reciprocals of the denominators
   // Feature terms: one plane per channel of every term.
   std::vector<int> termBegin_;
   std::vector<bool> termCentreOnly_;
@@ -147,6 +148,15 @@ FeatureNlMeansKernel::FeatureNlMeansKernel(std::span<const Image* const> data,
       g_.set(c, *patch->guide, c);
       vn_.set(c, *patch->variance, c, patch->alpha);
       vd_.set(c, *patch->variance, c, patch->k * patch->k);
+    }
+    if (patchCentreOnly_) {
+      invPair_ = invSym_ = BorderedPlanes(width_, height_, patchChannels_, pad_);
+      for (int c = 0; c < patchChannels_; ++c)
+        tbb::parallel_for(-pad_, height_ + pad_, [&](int y) {
+          rows::centreReciprocals(width_ + 2 * pad_, vd_.row(c, y) - pad_,
+                                  invPair_.mutableRow(c, y) - pad_,
+                                  invSym_.mutableRow(c, y) - pad_);
+        });
     }
   }
   int channels = 0;
@@ -247,6 +257,14 @@ void FeatureNlMeansKernel::patchWeights(const PixelRect& tile, int dx, int dy,
   for (int y = ext.y0; y < ext.y1; ++y) {
     const size_t e = size_t(y - ext.y0) * size_t(ew);
     for (int c = 0; c < patchChannels_; ++c) {
+      if (patchCentreOnly_) {
+        rows::addCentreColorDistances(
+            ew, g_.row(c, y) + ox, g_.row(c, y + dy) + ox + dx, g_.row(c, y - dy) + ox - dx,
+            vn_.row(c, y) + ox, vn_.row(c, y + dy) + ox + dx, vn_.row(c, y - dy) + ox - dx,
+            invPair_.row(c, y) + ox, invSym_.row(c, y) + ox, share, c == 0, m.ext[kPlus].data() + e,
+            m.ext[kMinus].data() + e, m.ext[kSym].data() + e);
+        continue;
+      }
       const float* vd = vd_.row(c, y) + ox;
       rows::addColorDistances(
           ew, g_.row(c, y) + ox, g_.row(c, y + dy) + ox + dx, g_.row(c, y - dy) + ox - dx,

@@ -123,22 +123,65 @@ void featureTermWeights(int n, int channels, size_t planeStride, const float* f,
   }
 }
 
-// One pixel's colour distances (addColorDistances).
-inline void colorDistances(float g, float gp, float gm, float vn, float vnp, float vnm, float vd,
-                           float vdp, float vdm, float channelShare, float neighbourShare,
-                           float clamp, float& plus, float& minus, float& sym) {
+// One pixel's colour distances from the reciprocals of their denominators.
+inline void colorDistancesWith(float g, float gp, float gm, float vn, float vnp, float vnm,
+                               float invP, float invM, float invS, float channelShare, float clamp,
+                               float& plus, float& minus, float& sym) {
   const float mp = std::min(vn, vnp), mm = std::min(vn, vnm);
   const float diffP = g - gp, diffM = g - gm;
   const float diffS = g - 0.5f * (gp + gm);
-  const float invP = 1.0f / (vd + vdp + kEpsilon);
-  const float invM = 1.0f / (vd + vdm + kEpsilon);
-  const float invS = 1.0f / (vd + neighbourShare * (vdp + vdm) + kEpsilon);
   const float dp = channelShare * ((diffP * diffP - (vn + mp)) * invP);
   const float dm = channelShare * ((diffM * diffM - (vn + mm)) * invM);
   const float ds = channelShare * ((diffS * diffS - (vn + 0.25f * (mp + mm))) * invS);
   plus += dp <= clamp ? dp : clamp;
   minus += dm <= clamp ? dm : clamp;
   sym += ds <= clamp ? ds : clamp;
+}
+
+// One pixel's colour distances (addColorDistances).
+inline void colorDistances(float g, float gp, float gm, float vn, float vnp, float vnm, float vd,
+                           float vdp, float vdm, float channelShare, float neighbourShare,
+                           float clamp, float& plus, float& minus, float& sym) {
+  const float invP = 1.0f / (vd + vdp + kEpsilon);
+  const float invM = 1.0f / (vd + vdm + kEpsilon);
+  const float invS = 1.0f / (vd + neighbourShare * (vdp + vdm) + kEpsilon);
+  colorDistancesWith(g, gp, gm, vn, vnp, vnm, invP, invM, invS, channelShare, clamp, plus, minus,
+                     sym);
+}
+
+ROW_KERNEL
+void centreReciprocals(int n, const float* __restrict vd, float* __restrict invPair,
+                       float* __restrict invSym) {
+  // The expressions of colorDistances with vdp = vdm = vd and neighbourShare ½, so the same bits.
+  const float neighbourShare = 0.5f;
+  for (int i = 0; i < n; ++i) {
+    invPair[i] = 1.0f / (vd[i] + vd[i] + kEpsilon);
+    invSym[i] = 1.0f / (vd[i] + neighbourShare * (vd[i] + vd[i]) + kEpsilon);
+  }
+}
+
+ROW_KERNEL
+void addCentreColorDistances(int n, const float* __restrict g, const float* __restrict gp,
+                             const float* __restrict gm, const float* __restrict vn,
+                             const float* __restrict vnp, const float* __restrict vnm,
+                             const float* __restrict invPair, const float* __restrict invSym,
+                             float channelShare, bool first, float* __restrict plus,
+                             float* __restrict minus, float* __restrict sym) {
+  const float clamp = kClamp * channelShare;
+  if (first) {
+    for (int i = 0; i < n; ++i) {
+      float p = 0.0f, m = 0.0f, q = 0.0f;
+      colorDistancesWith(g[i], gp[i], gm[i], vn[i], vnp[i], vnm[i], invPair[i], invPair[i],
+                         invSym[i], channelShare, clamp, p, m, q);
+      plus[i] = p;
+      minus[i] = m;
+      sym[i] = q;
+    }
+    return;
+  }
+  for (int i = 0; i < n; ++i)
+    colorDistancesWith(g[i], gp[i], gm[i], vn[i], vnp[i], vnm[i], invPair[i], invPair[i], invSym[i],
+                       channelShare, clamp, plus[i], minus[i], sym[i]);
 }
 
 ROW_KERNEL

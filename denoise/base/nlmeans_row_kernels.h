@@ -45,6 +45,16 @@ void addColorDistances(int n, const float* g, const float* gp, const float* gm, 
                        float* plus, float* minus, float* sym, float* sPlus, float* sMinus,
                        float* sSym);
 
+// Centre-only denominators (vdp = vdm = vd, neighbourShare ½) depend on p alone:
+// invPair = 1 / (2 vd + ε), invSym = 1 / (vd + ½ (vd + vd) + ε), once per pixel.
+void centreReciprocals(int n, const float* vd, float* invPair, float* invSym);
+
+// addColorDistances with centre-only denominators, from centreReciprocals' planes (same bits).
+void addCentreColorDistances(int n, const float* g, const float* gp, const float* gm,
+                             const float* vn, const float* vnp, const float* vnm,
+                             const float* invPair, const float* invSym, float channelShare,
+                             bool first, float* plus, float* minus, float* sym);
+
 // One feature channel's pixel distances (clamped) to p + δ, p − δ and to their mean, added to
 // plus / minus / sym, with one denominator set (symmetric: den + neighbourShare (denp + denm)).
 // sym may be null (no symmetric distance).

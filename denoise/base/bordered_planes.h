@@ -3,13 +3,12 @@
 // a kernel may read any neighbour within `pad` pixels of the image without bounds checks.
 // Unlike PaddedPlanes (denoise/image/padded_planes.h: SIMD-aligned rows with horizontal margins
 // only, for à-trous), the border surrounds the image on all four sides.
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cstddef>
 #include <vector>
 
 #include "denoise/image/image.h"
+#include "denoise/util/parallel_rows.h"
 
 namespace chorus {
 
@@ -24,7 +23,7 @@ class BorderedPlanes {
   // Channel c of this ← channel sourceChannel of image × scale (rows in parallel: the filters
   // set up dozens of planes before their parallel loops).
   void set(int c, const Image& image, int sourceChannel, float scale = 1.0f) {
-    tbb::parallel_for(0, image.height(), [&](int y) {
+    parallelRows(0, image.height(), [&](int y) {
       float* row = mutableRow(c, y);
       for (int x = 0; x < image.width(); ++x) row[x] = scale * image(x, y, sourceChannel);
     });

@@ -1,13 +1,12 @@
 #include "denoise/base/buffer_variance.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "denoise/base/filters/box_filter.h"
+#include "denoise/util/parallel_rows.h"
 
 namespace chorus {
 namespace {
@@ -86,7 +85,7 @@ Image smooth3Tap(const Image& image, float sideWeight, const std::vector<uint8_t
   const int w = image.width(), h = image.height(), channels = image.channels();
   auto pass = [&](const Image& in, int sx, int sy) {
     Image out(w, h, channels);
-    tbb::parallel_for(0, h, [&](int y) {
+    parallelRows(0, h, [&](int y) {
       for (int x = 0; x < w; ++x) {
         const size_t centre = size_t(y) * size_t(w) + size_t(x);
         for (int c = 0; c < channels; ++c) {

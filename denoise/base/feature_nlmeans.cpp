@@ -7,11 +7,12 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "denoise/base/bordered_planes.h"
 #include "denoise/base/filters/pixel_rect.h"
 #include "denoise/base/nlmeans_row_kernels.h"
-#include "denoise/base/bordered_planes.h"
 #include "denoise/base/rect_mask.h"
 #include "denoise/util/float_lanes.h"
+#include "denoise/util/parallel_rows.h"
 
 namespace chorus {
 namespace {
@@ -152,7 +153,7 @@ FeatureNlMeansKernel::FeatureNlMeansKernel(std::span<const Image* const> data,
     if (patchCentreOnly_) {
       invPair_ = invSym_ = BorderedPlanes(width_, height_, patchChannels_, pad_);
       for (int c = 0; c < patchChannels_; ++c)
-        tbb::parallel_for(-pad_, height_ + pad_, [&](int y) {
+        parallelRows(-pad_, height_ + pad_, [&](int y) {
           rows::centreReciprocals(width_ + 2 * pad_, vd_.row(c, y) - pad_,
                                   invPair_.mutableRow(c, y) - pad_,
                                   invSym_.mutableRow(c, y) - pad_);

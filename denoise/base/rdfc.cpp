@@ -1,7 +1,5 @@
 #include "denoise/base/rdfc.h"
 
-#include <tbb/parallel_for.h>
-
 #include <cmath>
 #include <span>
 #include <string>
@@ -9,6 +7,7 @@
 #include "denoise/base/buffer_variance.h"
 #include "denoise/base/feature_nlmeans.h"
 #include "denoise/util/error.h"
+#include "denoise/util/parallel_rows.h"
 
 namespace chorus {
 namespace {
@@ -48,7 +47,7 @@ void selectCandidates(const Image& guide, const Image& variance, const RdfcParam
 
   result.selection = Image(w, h, 1);
   std::array<Image, 3> binary = {Image(w, h, 1), Image(w, h, 1), Image(w, h, 1)};
-  tbb::parallel_for(0, h, [&](int y) {
+  parallelRows(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       auto meanDerivative = [&](int s) {
         const Image& d = result.candidates[size_t(s)].derivative;
@@ -77,7 +76,7 @@ void selectCandidates(const Image& guide, const Image& variance, const RdfcParam
 Image blendCandidates(const RdfcResult& result, Image RdfcCandidate::*buffer) {
   const Image& first = result.candidates[0].*buffer;
   Image out(first.width(), first.height(), 3);
-  tbb::parallel_for(0, out.height(), [&](int y) {
+  parallelRows(0, out.height(), [&](int y) {
     for (int x = 0; x < out.width(); ++x) {
       float total = 0.0f;
       for (int s = 0; s < 3; ++s) total += result.selectionWeights[size_t(s)](x, y, 0);

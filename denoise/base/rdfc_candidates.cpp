@@ -8,12 +8,13 @@
 #include <limits>
 #include <stdexcept>
 
+#include "denoise/base/bordered_planes.h"
 #include "denoise/base/filters/pixel_rect.h"
 #include "denoise/base/nlmeans_row_kernels.h"
-#include "denoise/base/bordered_planes.h"
 #include "denoise/base/rect_mask.h"
 #include "denoise/base/sure.h"
 #include "denoise/util/float_lanes.h"
+#include "denoise/util/parallel_rows.h"
 
 namespace chorus {
 namespace {
@@ -432,7 +433,7 @@ std::array<RdfcCandidate, 3> CandidateKernel::run() const {
     cand.derivative = std::move(out.derivative[size_t(s)]);
     cand.mean = Image(width_, height_, 3);
     cand.sure = Image(width_, height_, 1);
-    tbb::parallel_for(0, height_, [&](int y) {
+    parallelRows(0, height_, [&](int y) {
       for (int x = 0; x < width_; ++x) {
         float sum = 0.0f;
         for (int c = 0; c < 3; ++c) {

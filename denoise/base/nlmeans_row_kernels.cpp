@@ -102,6 +102,70 @@ ROW_KERNEL void featureTermWeightsOf(int n, size_t stride, const float* __restri
   }
 }
 
+// Skipping (featureTermWeights): chunks of kChunk pixels.
+constexpr int kChunk = 16, kMaxChunks = 64;
+
+// matters[k] = 1 where some numerator of the distances of chunk k (pixels [16 k, 16 k + 16)) is
+// positive or NaN. Elsewhere every distance is ≤ 0 (the denominators are positive), all three
+// weights of both sets are exactly 1, the refinement factor is 0, and the minima, which start at
+// 1 and only fall, keep their values: the chunk changes nothing.
+template <int C>
+ROW_KERNEL void featureTermChunks(int chunks, size_t stride, const float* __restrict f,
+                                  const float* __restrict fp, const float* __restrict fm,
+                                  const float* __restrict vn, const float* __restrict vnp,
+                                  const float* __restrict vnm, unsigned char* __restrict matters) {
+  for (int chunk = 0; chunk < chunks; ++chunk) {
+    int any = 0;
+    for (int j = 0; j < kChunk; ++j) {
+#pragma GCC unroll 4
+      for (int c = 0; c < C; ++c) {
+        const size_t k = size_t(c) * stride + size_t(chunk * kChunk + j);
+        const float v = vn[k], mp = std::min(v, vnp[k]), mm = std::min(v, vnm[k]);
+        const float diffP = f[k] - fp[k], diffM = f[k] - fm[k];
+        const float diffS = f[k] - 0.5f * (fp[k] + fm[k]);
+        const float numP = diffP * diffP - (v + mp), numM = diffM * diffM - (v + mm);
+        const float numS = diffS * diffS - (v + 0.25f * (mp + mm));
+        any |= int(!(numP <= 0.0f)) | int(!(numM <= 0.0f)) | int(!(numS <= 0.0f));
+      }
+    }
+    matters[chunk] = (unsigned char)any;
+  }
+}
+
+// featureTermWeightsOf<C> on the runs of chunks that matter (and the partial last chunk). The
+// runs start at multiples of 16, so every pixel goes through the same vector or tail code as in
+// one call over the row (the AVX-512 build's tail may differ in the last bit).
+template <int C>
+void featureTermRuns(int n, size_t stride, const float* f, const float* fp, const float* fm,
+                     const float* vn, const float* vnp, const float* vnm, const float* kv,
+                     const float* kvp, const float* kvm, float floorA, float floorB,
+                     const float* symMask, float minRefineWeight, float* plusA, float* minusA,
+                     float* plusB, float* minusB) {
+  const int chunks = n / kChunk;
+  if (chunks > kMaxChunks) {
+    featureTermWeightsOf<C>(n, stride, f, fp, fm, vn, vnp, vnm, kv, kvp, kvm, floorA, floorB,
+                            symMask, minRefineWeight, plusA, minusA, plusB, minusB);
+    return;
+  }
+  unsigned char matters[kMaxChunks];
+  featureTermChunks<C>(chunks, stride, f, fp, fm, vn, vnp, vnm, matters);
+  auto needed = [&](int chunk) { return chunk >= chunks || matters[chunk]; };
+  for (int chunk = 0; chunk * kChunk < n;) {
+    if (!needed(chunk)) {
+      ++chunk;
+      continue;
+    }
+    int end = chunk;
+    while (end * kChunk < n && needed(end)) ++end;
+    const size_t a = size_t(chunk * kChunk);
+    const int count = std::min(n, end * kChunk) - chunk * kChunk;
+    featureTermWeightsOf<C>(count, stride, f + a, fp + a, fm + a, vn + a, vnp + a, vnm + a, kv + a,
+                            kvp + a, kvm + a, floorA, floorB, symMask + a, minRefineWeight,
+                            plusA + a, minusA + a, plusB + a, minusB + a);
+    chunk = end;
+  }
+}
+
 void featureTermWeights(int n, int channels, size_t planeStride, const float* f, const float* fp,
                         const float* fm, const float* vn, const float* vnp, const float* vnm,
                         const float* kv, const float* kvp, const float* kvm, float floorA,
@@ -110,9 +174,8 @@ void featureTermWeights(int n, int channels, size_t planeStride, const float* f,
   switch (channels) {
 #define CHORUS_TERM_CASE(C)                                                                  \
   case C:                                                                                    \
-    return featureTermWeightsOf<C>(n, planeStride, f, fp, fm, vn, vnp, vnm, kv, kvp, kvm,    \
-                                   floorA, floorB, symMask, minRefineWeight, plusA, minusA, \
-                                   plusB, minusB);
+    return featureTermRuns<C>(n, planeStride, f, fp, fm, vn, vnp, vnm, kv, kvp, kvm, floorA, \
+                              floorB, symMask, minRefineWeight, plusA, minusA, plusB, minusB);
     CHORUS_TERM_CASE(1)
     CHORUS_TERM_CASE(2)
     CHORUS_TERM_CASE(3)

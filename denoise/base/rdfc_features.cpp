@@ -6,6 +6,7 @@
 
 #include "denoise/base/buffer_variance.h"
 #include "denoise/base/feature_nlmeans.h"
+#include "denoise/util/parallel_rows.h"
 
 namespace chorus {
 namespace {
@@ -115,16 +116,31 @@ std::vector<RdfcFeature> prefilterRdfcFeatures(const DenoiseInput& input,
   const SubBuffer& h2 = (*input.halves)[1];
   const float maxDepth = largestFiniteValue(whole.depth.mean);
 
-  std::vector<RdfcFeature> features;
-  features.push_back(prefilter("normal", mapNormal(whole.normal), mapNormal(h1.normal),
-                               mapNormal(h2.normal), 1.0f, params));
-  features.push_back(prefilter("albedo", mapAlbedo(whole.albedo), mapAlbedo(h1.albedo),
-                               mapAlbedo(h2.albedo), 1.0f, params));
+  // The four features side by side: each one's serial steps (mapping, variance rescaling,
+  // gradients) overlap the others' parallel filtering. Each is computed alone, in the caller's
+  // floating-point state (parallelRows), so the results do not change.
+  std::vector<RdfcFeature> features(4);
   auto plain = [](const MeanVariance& q) { return MappedFeature{q.mean, q.varianceOfMean}; };
-  features.push_back(prefilter("depth", plain(whole.depth), plain(h1.depth), plain(h2.depth),
-                               maxDepth * maxDepth, params));
-  features.push_back(prefilter("visibility", plain(whole.visibility), plain(h1.visibility),
-                               plain(h2.visibility), 1.0f, params));
+  parallelRows(0, 4, [&](int j) {
+    switch (j) {
+      case 0:
+        features[0] = prefilter("normal", mapNormal(whole.normal), mapNormal(h1.normal),
+                                mapNormal(h2.normal), 1.0f, params);
+        break;
+      case 1:
+        features[1] = prefilter("albedo", mapAlbedo(whole.albedo), mapAlbedo(h1.albedo),
+                                mapAlbedo(h2.albedo), 1.0f, params);
+        break;
+      case 2:
+        features[2] = prefilter("depth", plain(whole.depth), plain(h1.depth), plain(h2.depth),
+                                maxDepth * maxDepth, params);
+        break;
+      default:
+        features[3] = prefilter("visibility", plain(whole.visibility), plain(h1.visibility),
+                                plain(h2.visibility), 1.0f, params);
+        break;
+    }
+  });
   return features;
 }
 

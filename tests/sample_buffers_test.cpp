@@ -94,6 +94,21 @@ TEST(SampleBuffers, MergeMatchesStatisticsOfRawSamples) {
   expectMergeMatchesRaw(raw, {3, 0, 2});
 }
 
+// Two parts take a shorter path through merge(); adding a third part without samples sends
+// the same data through the general loop, which must give the same values.
+TEST(SampleBuffers, TwoPartMergeEqualsTheGeneralMerge) {
+  const RawBuffers raw = makeRaw(37, 29, 2);
+  const SubBuffer none = SubBuffer::zeros(37, 29);
+  const SubBuffer two = merge({&raw.buffers.sub(0), &raw.buffers.sub(1)});
+  const SubBuffer general = merge({&raw.buffers.sub(0), &raw.buffers.sub(1), &none});
+  for (Quantity q : kAllQuantities)
+    for (const auto& [fast, slow] : {std::pair{&two.get(q).mean, &general.get(q).mean},
+                                     std::pair{&two.get(q).varianceOfMean,
+                                               &general.get(q).varianceOfMean}})
+      for (size_t e = 0; e < fast->size(); ++e)
+        ASSERT_EQ(fast->data()[e], slow->data()[e]) << quantityName(q) << " element " << e;
+}
+
 TEST(SampleBuffers, InputsUseTheDocumentedQuarters) {
   const RawBuffers raw = makeRaw(4, 3, 4);
   const DenoiseInput a = raw.buffers.input(BufferPart::HalfA);

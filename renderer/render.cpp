@@ -51,7 +51,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
   const LightSet lights(scene);
   const PathTracer tracer(scene, lights,
                           PathTracerSettings{options.maxDepth, options.rouletteStartDepth});
-  Film film(resolution.width, resolution.height, options.splits);
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  Film film =
+      arena.execute([&] { return Film(resolution.width, resolution.height, options.splits); });
 
   const int tilesX = (resolution.width + kTileSize - 1) / kTileSize;
   const int tilesY = (resolution.height + kTileSize - 1) / kTileSize;
@@ -89,7 +91,6 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
     }
   };
 
-  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute([&] {
     tbb::parallel_for(
         tbb::blocked_range<int>(0, tilesX * tilesY, 1),

@@ -1,5 +1,7 @@
 #include "renderer/integrator/film.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -40,7 +42,11 @@ bool PixelAccumulator::add(int k, const PathSample& sample) {
 Film::Film(int width, int height, int splits) : width_(width), height_(height) {
   if (splits != 1 && splits != 2 && splits != 4)
     throw std::invalid_argument("Film: splits must be 1, 2 or 4");
-  for (int k = 0; k < splits; ++k) subBuffers_.push_back(SubBuffer::zeros(width, height));
+  // Allocated and zeroed on as many threads as there are sub-buffers: the first touch of 24 MB
+  // per sub-buffer at 512² was serial time in a 1-second preview.
+  subBuffers_.resize(size_t(splits));
+  tbb::parallel_for(0, splits,
+                    [&](int k) { subBuffers_[size_t(k)] = SubBuffer::zeros(width, height); });
 }
 
 void Film::store(int x, int y, const PixelAccumulator& pixel) {

@@ -128,6 +128,31 @@ inline Vec3f orientedGeometricNormal(const SceneMesh& sm, uint32_t primID, const
   return ng;
 }
 
+// SceneMesh::flatFrames: what interaction() computes for a flat triangle, at vertex 0 (the
+// interpolated normal is then the shared one exactly; elsewhere it may differ in its last bit).
+std::vector<SceneMesh::FlatFrame> flatFrames(const SceneMesh& sm, const MaterialDesc& material) {
+  const MeshDesc& mesh = sm.mesh;
+  if (!mesh.tangents.empty() || (material.normalTexture >= 0 && !mesh.uvs.empty())) return {};
+  const auto same = [](const Vec3f& a, const Vec3f& b) {
+    return a.x == b.x && a.y == b.y && a.z == b.z;
+  };
+  std::vector<SceneMesh::FlatFrame> frames(mesh.triangleCount());
+  bool any = false;
+  for (uint32_t primID = 0; primID < frames.size(); ++primID) {
+    const uint32_t* idx = &mesh.indices[3 * size_t(primID)];
+    if (!mesh.normals.empty() && !(same(mesh.normals[idx[0]], mesh.normals[idx[1]]) &&
+                                   same(mesh.normals[idx[0]], mesh.normals[idx[2]])))
+      continue;
+    Vec3f ns;
+    const Vec3f ng = orientedGeometricNormal(sm, primID, idx, 1.0f, 0.0f, 0.0f, &ns);
+    const Frame frame = Frame::fromZ(ns);
+    frames[primID] = {ng, frame.z, frame.x, true};
+    any = true;
+  }
+  if (!any) return {};
+  return frames;
+}
+
 }  // namespace
 
 Scene::Scene() : data_(std::make_unique<SceneData>()), embree_(std::make_unique<Embree>()) {}
@@ -159,6 +184,7 @@ Scene buildScene(SceneDesc desc, EnvironmentDesc environment) {
     for (uint32_t primID = 0; primID < sm.faceNormals.size(); ++primID)
       sm.faceNormals[primID] = faceNormal(sm.mesh, primID);
     const Material& material = data.materials[size_t(sm.mesh.material)];
+    sm.flatFrames = flatFrames(sm, material.desc);
     sm.alphaTested = material.alphaTested;
     if (material.desc.isEmissive()) {
       sm.firstAreaLight = int(data.areaLightCount);
@@ -280,6 +306,14 @@ SurfaceInteraction Scene::interaction(const Hit& hit, const Vec3f& rayDirection)
   si.positionError = barycentricPositionError(p0, p1, p2, b0, b1, b2);
   si.uv = mesh.uvs.empty() ? Vec2f{0, 0}
                            : mesh.uvs[idx[0]] * b0 + mesh.uvs[idx[1]] * b1 + mesh.uvs[idx[2]] * b2;
+  if (!sm.flatFrames.empty() && sm.flatFrames[hit.primID].valid) {
+    const SceneMesh::FlatFrame& flat = sm.flatFrames[hit.primID];
+    si.shadingNormal = flat.shadingNormal;
+    si.tangent = flat.tangent;
+    si.geometricNormal = flat.geometricNormal;
+    si.frontFace = dot(rayDirection, flat.geometricNormal) < 0;
+    return si;
+  }
   Vec3f ns;
   const Vec3f ng = orientedGeometricNormal(sm, hit.primID, idx, b0, b1, b2, &ns);
 

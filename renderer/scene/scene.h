@@ -48,6 +48,15 @@ struct SceneMesh {
   // Unit normal of each triangle from its winding ((0, 0, 1) when degenerate), computed once:
   // every hit and every light sample needs it.
   std::vector<Vec3f> faceNormals;
+  // Triangles shaded flat (no vertex normals or three equal ones; no tangents or normal map):
+  // their oriented geometric normal, shading normal and tangent, computed once. Per hit, the
+  // normalisation of the interpolated normal and the frame's divisions were a chain of
+  // dependent divisions, about half of interaction()'s time. Empty when no triangle qualifies.
+  struct FlatFrame {
+    Vec3f geometricNormal, shadingNormal, tangent;
+    bool valid = false;
+  };
+  std::vector<FlatFrame> flatFrames;  // by primID
   int firstAreaLight = -1;  // area light index of primID 0 when the material emits
   bool alphaTested = false;
 };

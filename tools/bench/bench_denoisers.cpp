@@ -193,7 +193,8 @@ void printDifference(const std::string& what, const Image& a, const Image& b) {
     maxAbs = std::max(maxAbs, d);
     if (scale > 0) maxRel = std::max(maxRel, d / scale);
   }
-  std::printf("  %s: max |diff| %.3g, max rel diff %.3g\n", what.c_str(), maxAbs, maxRel);
+  std::printf("  %s: max |diff| %.3g, max rel diff %.3g, relMSE against it %.5g\n", what.c_str(),
+              maxAbs, maxRel, relMse(a, b));
 }
 
 // relMSE of the per-pixel best of `outputs` (those with include[i]), judged by the reference.
@@ -280,7 +281,7 @@ void run(const BenchOptions& o) {
         best.wallSeconds = std::min(best.wallSeconds, t.wallSeconds);
         best.cpuSeconds = std::min(best.cpuSeconds, t.cpuSeconds);
       }
-      std::printf("| %s | %s | %.3f | %.3f | %.5f | %.5f |\n", c.name.c_str(), spec.c_str(),
+      std::printf("| %s | %s | %.3f | %.3f | %.5g | %.5g |\n", c.name.c_str(), spec.c_str(),
                   best.wallSeconds / megapixels, best.cpuSeconds / megapixels,
                   relMse(output, c.reference), noisy);
       std::fflush(stdout);

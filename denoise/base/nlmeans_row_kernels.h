@@ -71,6 +71,19 @@ void horizontalBoxSum(int n, const float* src, int r, float* dst);
 void verticalBoxMean(int n, const float* src, size_t stride, int count, float scaleY,
                      const float* scaleX, float* dst);
 
+// dst[i] = (inner[i − r0 − 1] + src[i]) + inner[i + r0 + 1]: the box sums of radius 2 r0 + 1
+// from those of radius r0 (inner readable from −r0 − 1 to n + r0 + 1), 2 additions a pixel
+// instead of 4 r0 + 2.
+void widenBoxSum(int n, const float* src, const float* inner, int r0, float* dst);
+
+// verticalBoxMean for `rows` consecutive output rows (rows dstStride apart, scaleY per row) with
+// running column sums: each row adds the entering row sum and subtracts the leaving one
+// (`running`: n floats of scratch). The sums restart from a full one at every call, so their
+// rounding error is bounded by one call's rows and does not grow with the image.
+void runningBoxMeans(int n, int rows, const float* src, size_t stride, int count,
+                     const float* scaleY, const float* scaleX, float* running, float* dst,
+                     size_t dstStride);
+
 // out = min(a, b).
 void minWeights(int n, const float* a, const float* b, float* out);
 

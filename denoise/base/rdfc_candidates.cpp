@@ -39,6 +39,7 @@ struct TileMemory {
   std::vector<float> featPlus[2], featMinus[2];  // feature weights, τ sets FIRST/SECOND, THIRD
   std::vector<float> ext[3];                     // colour pixel distances over the grown tile
   std::vector<float> rowSums, invCountX;         // box filter: horizontal sums, 1 / x counts
+  std::vector<float> innerSums, invY, running;   // the narrower patch's sums, 1 / y counts
   std::vector<float> dist[kColor][3], invCountStore[kColor][3];
   std::vector<float> fullInvCountX[kColor], fullInvCount[kColor];  // boxes inside the image
   const float* invCount[kColor][3] = {};  // 1 / box counts of this offset
@@ -223,36 +224,70 @@ void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, Tile
   // Patch means for both patch radii: box sums over the valid pixels × 1 / their count. Where
   // every box of the tile lies inside the valid pixels, the counts are those of the full patch
   // (planes filled once per tile).
-  for (int s = 0; s < kColor; ++s) {
+  auto patchMeans = [&](int s, int kind, const float* sums, size_t stride) {
     const int f = patch_[s];
-    for (int kind = 0; kind < 3; ++kind) {
-      const std::vector<float>& e = m.ext[kind];
-      const bool full = tile.x0 - f >= loX[kind] && tile.x1 + f <= hiX[kind] &&
-                        tile.y0 - f >= loY[kind] && tile.y1 + f <= hiY[kind];
-      const float* invX = m.fullInvCountX[s].data();
-      if (!full) {
-        for (int i = 0; i < tw; ++i) {
-          const int nx = boxOverlap(tile.x0 + i, f, loX[kind], hiX[kind]);
-          m.invCountX[size_t(i)] = nx > 0 ? 1.0f / float(nx) : 0.0f;
-        }
-        invX = m.invCountX.data();
+    const bool full = tile.x0 - f >= loX[kind] && tile.x1 + f <= hiX[kind] &&
+                      tile.y0 - f >= loY[kind] && tile.y1 + f <= hiY[kind];
+    const float* invX = m.fullInvCountX[s].data();
+    if (!full) {
+      for (int i = 0; i < tw; ++i) {
+        const int nx = boxOverlap(tile.x0 + i, f, loX[kind], hiX[kind]);
+        m.invCountX[size_t(i)] = nx > 0 ? 1.0f / float(nx) : 0.0f;
       }
+      invX = m.invCountX.data();
+    }
+    m.invCount[s][kind] = full ? m.fullInvCount[s].data() : m.invCountStore[s][kind].data();
+    for (int y = tile.y0; y < tile.y1; ++y) {
+      const int ny = boxOverlap(y, f, loY[kind], hiY[kind]);
+      const float invY = ny > 0 ? 1.0f / float(ny) : 0.0f;
+      m.invY[size_t(y - tile.y0)] = invY;
+      if (!full) {
+        float* inv = m.invCountStore[s][kind].data() + size_t(y - tile.y0) * size_t(tw);
+        for (int i = 0; i < tw; ++i) inv[i] = invY * invX[i];
+      }
+    }
+    // The 7-row boxes slide down the tile; 3 rows are summed directly (as cheap).
+    if (2 * f + 1 > 3) {
+      rows::runningBoxMeans(tw, th, sums, stride, 2 * f + 1, m.invY.data(), invX,
+                            m.running.data(), m.dist[s][kind].data(), size_t(tw));
+      return;
+    }
+    for (int y = tile.y0; y < tile.y1; ++y)
+      rows::verticalBoxMean(tw, sums + size_t(y - tile.y0) * stride, stride, 2 * f + 1,
+                            m.invY[size_t(y - tile.y0)], invX,
+                            m.dist[s][kind].data() + size_t(y - tile.y0) * size_t(tw));
+  };
+  auto extRow = [&](int kind, int y, int x) {
+    return m.ext[kind].data() + size_t(y - ey0) * size_t(ew) + size_t(x - ex0);
+  };
+  // With the default radii 1 and 3, the 7-wide sums are the 3-wide ones at ∓2 plus the centre.
+  const int f0 = patch_[0];
+  const bool widen = patch_[1] == 2 * f0 + 1;
+  for (int kind = 0; kind < 3; ++kind) {
+    if (widen) {
+      const int k = f0 + 1, iw = tw + 2 * k;
+      const size_t innerStride = size_t(iw);
+      // Inner (radius f0) sums over every grown row, k columns wider on each side.
+      for (int y = ey0; y < ey0 + eh; ++y)
+        rows::horizontalBoxSum(iw, extRow(kind, y, tile.x0 - k), f0,
+                               m.innerSums.data() + size_t(y - ey0) * innerStride);
+      patchMeans(0, kind, m.innerSums.data() + size_t(tile.y0 - f0 - ey0) * innerStride + size_t(k),
+                 innerStride);
+      for (int y = ey0; y < ey0 + eh; ++y)
+        rows::widenBoxSum(tw, extRow(kind, y, tile.x0),
+                          m.innerSums.data() + size_t(y - ey0) * innerStride + size_t(k), f0,
+                          m.rowSums.data() + size_t(y - ey0) * size_t(tw));
+      patchMeans(1, kind, m.rowSums.data() + size_t(tile.y0 - patch_[1] - ey0) * size_t(tw),
+                 size_t(tw));
+      continue;
+    }
+    for (int s = 0; s < kColor; ++s) {
+      const int f = patch_[s];
       // Horizontal sums for the rows [tile.y0 − f, tile.y1 + f), tile columns.
       for (int y = tile.y0 - f; y < tile.y1 + f; ++y)
-        rows::horizontalBoxSum(tw, e.data() + size_t(y - ey0) * size_t(ew) + size_t(tile.x0 - ex0),
-                               f, m.rowSums.data() + size_t(y - tile.y0 + f) * size_t(tw));
-      m.invCount[s][kind] = full ? m.fullInvCount[s].data() : m.invCountStore[s][kind].data();
-      for (int y = tile.y0; y < tile.y1; ++y) {
-        const size_t row = size_t(y - tile.y0) * size_t(tw);
-        const int ny = boxOverlap(y, f, loY[kind], hiY[kind]);
-        const float invY = ny > 0 ? 1.0f / float(ny) : 0.0f;
-        if (!full) {
-          float* inv = m.invCountStore[s][kind].data() + row;
-          for (int i = 0; i < tw; ++i) inv[i] = invY * invX[i];
-        }
-        rows::verticalBoxMean(tw, m.rowSums.data() + row, size_t(tw), 2 * f + 1, invY, invX,
-                              m.dist[s][kind].data() + row);
-      }
+        rows::horizontalBoxSum(tw, extRow(kind, y, tile.x0), f,
+                               m.rowSums.data() + size_t(y - tile.y0 + f) * size_t(tw));
+      patchMeans(s, kind, m.rowSums.data(), size_t(tw));
     }
   }
 
@@ -375,6 +410,9 @@ void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out
   for (auto& v : m.ext) v.resize(grownArea);
   m.rowSums.resize(size_t(kTileWidth) * size_t(kTileHeight + 2 * grow_));
   m.invCountX.resize(kTileWidth);
+  m.innerSums.resize(size_t(kTileWidth + 2 * grow_ + 2) * size_t(kTileHeight + 2 * grow_));
+  m.invY.resize(kTileHeight);
+  m.running.resize(kTileWidth);
   for (int s = 0; s < kColor; ++s) {
     const float inv = 1.0f / float(2 * patch_[s] + 1);
     m.fullInvCountX[s].assign(kTileWidth, inv);

@@ -32,10 +32,13 @@ inline float weightOf(float d) {
   return expClamped(-clamped) * float(d < 87.0f);
 }
 
-// Symmetric-pair refinement factor a (0 where it does not apply).
-inline float refineFactor(float w1, float w2, float ws, float mask, float minWeight) {
-  const float a = std::min(std::max(ws / (w1 + w2) - 1.0f, 0.0f), 1.0f);
+// Symmetric-pair refinement factor a (0 where it does not apply), from t = ws / (w1 + w2) − 1.
+inline float refineFactorOf(float t, float w1, float w2, float mask, float minWeight) {
+  const float a = std::min(std::max(t, 0.0f), 1.0f);
   return (mask > 0.0f) & (w1 >= minWeight) & (w2 >= minWeight) ? a : 0.0f;
+}
+inline float refineFactor(float w1, float w2, float ws, float mask, float minWeight) {
+  return refineFactorOf(ws / (w1 + w2) - 1.0f, w1, w2, mask, minWeight);
 }
 
 // One term's refined weights for δ and −δ from its distance sums (× scale, the channel mean),
@@ -549,18 +552,22 @@ ROW_KERNEL void accumulateColorCandidateOf(int n, const ColorCandidateRow& row,
     // The weights and the terms of their derivatives.
     const float w1 = maskPlus[i] * weightOf(dPlus[i]), w2 = maskMinus[i] * weightOf(dMinus[i]);
     const float ws = weightOf(dSym[i]);
-    const float sum = w1 + w2, t = ws / sum - 1.0f;
-    const float a = refineFactor(w1, w2, ws, maskSym[i], minRefineWeight);
+    // One division for both the refinement and its derivative: a from ws · (1 / sum) rather
+    // than ws / sum (a rounding-level change), 1 / sum² as its square.
+    const float sum = w1 + w2, invSum = 1.0f / sum, t = ws * invSum - 1.0f;
+    const float a = refineFactorOf(t, w1, w2, maskSym[i], minRefineWeight);
     const float r1 = a * ws + (1.0f - a) * w1, r2 = a * ws + (1.0f - a) * w2;
     const float v1 = std::min(r1, fPlus[i]), v2 = std::min(r2, fMinus[i]);
     const float m = maxWeight[i];
     const float pick2 = float((v2 > m) & (v2 > v1));
-    const float inv = 1.0f / (sum * sum + 1e-30f);  // finite; sum ≥ 2e^−25 where refining
     // ∂w / ∂D · (1 / patch count): −w where 0 < D < 87, else 0
     const float k1 = -w1 * invCountPlus[i] * float(dPlus[i] > 0.0f);
     const float k2 = -w2 * invCountMinus[i] * float(dMinus[i] > 0.0f);
     const float ks = -ws * invCountSym[i] * float(dSym[i] > 0.0f);
-    const float invSum2 = float((a > 0.0f) & (t < 1.0f)) * inv;  // where a ∈ (0, 1)
+    // Where a ∈ (0, 1); there sum ≥ 2e^−25, so 1 / sum < 4e10 and the bound (1 / 0 = ∞
+    // elsewhere) changes nothing where it is used.
+    const float boundedInv = std::min(invSum, 1e15f);
+    const float invSum2 = float((a > 0.0f) & (t < 1.0f)) * (boundedInv * boundedInv);
     const float pass1 = float(r1 < fPlus[i]), pass2 = float(r2 < fMinus[i]);
     const float pick1 = float(v1 > m) * (1.0f - pick2);
     // Their derivatives with respect to each channel of y(p), against the maximum before δ.

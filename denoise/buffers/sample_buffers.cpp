@@ -70,49 +70,6 @@ const MeanVariance& SubBuffer::get(Quantity q) const {
   return const_cast<SubBuffer*>(this)->get(q);
 }
 
-namespace {
-
-// merge() of two parts over pixels [first, first + size), with the per-pixel terms merge()
-// computed: the same arithmetic in the same order as its general loop (so the same bits),
-// without that loop's per-element indirection and bookkeeping (a third of a 4-spp preview's
-// merge time went to it).
-void mergeTwo(const SubBuffer& a, const SubBuffer& b, size_t first, size_t size,
-              const std::vector<double>& weight, const std::vector<double>& samples,
-              const std::vector<double>& varianceScale, SubBuffer& out) {
-  for (Quantity q : kAllQuantities) {
-    const size_t channels = size_t(channelCount(q));
-    const float *meanA = a.get(q).mean.data(), *meanB = b.get(q).mean.data();
-    const float *varianceA = a.get(q).varianceOfMean.data(),
-                *varianceB = b.get(q).varianceOfMean.data();
-    float* outMean = out.get(q).mean.data();
-    float* outVariance = out.get(q).varianceOfMean.data();
-    for (size_t i = 0; i < size; ++i) {
-      const double wA = weight[2 * i], wB = weight[2 * i + 1];
-      const double nA = samples[2 * i], nB = samples[2 * i + 1];
-      const bool hasA = wA > 0, hasB = wB > 0;
-      for (size_t e = (first + i) * channels; e < (first + i + 1) * channels; ++e) {
-        const double mA = hasA ? double(meanA[e]) : 0.0, mB = hasB ? double(meanB[e]) : 0.0;
-        double mean = 0;
-        mean += wA * mA;
-        mean += wB * mB;
-        double m2 = 0;
-        if (hasA) {
-          const double delta = mA - mean;
-          m2 += (double(varianceA[e]) * (nA - 1) + delta * delta) * nA;
-        }
-        if (hasB) {
-          const double delta = mB - mean;
-          m2 += (double(varianceB[e]) * (nB - 1) + delta * delta) * nB;
-        }
-        outMean[e] = float(mean);
-        outVariance[e] = float(m2 * varianceScale[i]);
-      }
-    }
-  }
-}
-
-}  // namespace
-
 SubBuffer merge(const std::vector<const SubBuffer*>& parts) {
   if (parts.empty()) throw std::invalid_argument("merge: no sub-buffers");
   const int w = parts[0]->width(), h = parts[0]->height();
@@ -143,39 +100,47 @@ SubBuffer merge(const std::vector<const SubBuffer*>& parts) {
         weight[i * count + k] = n > 0 ? samples[i * count + k] / n : 0.0;
       varianceScale[i] = n >= 2 ? 1.0 / (n * (n - 1)) : 0.0;
     }
-    if (count == 2) {  // the common case (K = 2 renders, the halves of K = 4): see mergeTwo
-      mergeTwo(*parts[0], *parts[1], first, size, weight, samples, varianceScale, out);
-      return;
-    }
-    std::vector<const float*> partMean(count), partVariance(count);
-    std::vector<double> means(count);
+    // Part by part over the block's values: each value receives its terms in part order, as
+    // in the formulas, while the inner loops run over plain arrays (per value, a loop over the
+    // parts through pointer tables was a third of the merge's time).
+    std::vector<double> mean, m2;
     for (Quantity q : kAllQuantities) {
-      const size_t channels = size_t(channelCount(q));
+      const size_t channels = size_t(channelCount(q)), values = size * channels;
+      const size_t offset = first * channels;
+      mean.assign(values, 0.0);
+      m2.assign(values, 0.0);
       for (size_t k = 0; k < count; ++k) {
-        partMean[k] = parts[k]->get(q).mean.data();
-        partVariance[k] = parts[k]->get(q).varianceOfMean.data();
-      }
-      float* outMean = out.get(q).mean.data();
-      float* outVariance = out.get(q).varianceOfMean.data();
-      for (size_t i = 0; i < size; ++i) {
-        const double* w = &weight[i * count];
-        const double* nk = &samples[i * count];
-        for (size_t e = (first + i) * channels; e < (first + i + 1) * channels; ++e) {
-          double mean = 0;
-          for (size_t k = 0; k < count; ++k) {
-            means[k] = w[k] > 0 ? double(partMean[k][e]) : 0.0;
-            mean += w[k] * means[k];
+        const float* partMean = parts[k]->get(q).mean.data() + offset;
+        for (size_t i = 0; i < size; ++i) {
+          const double w = weight[i * count + k];
+          for (size_t c = 0; c < channels; ++c) {
+            const size_t e = i * channels + c;
+            mean[e] += w * (w > 0 ? double(partMean[e]) : 0.0);
           }
-          double m2 = 0;  // M2_k = V_k n_k (n_k − 1), V_k the part's variance of the mean
-          for (size_t k = 0; k < count; ++k) {
-            if (!(w[k] > 0)) continue;
-            const double delta = means[k] - mean;
-            m2 += (double(partVariance[k][e]) * (nk[k] - 1) + delta * delta) * nk[k];
-          }
-          outMean[e] = float(mean);
-          outVariance[e] = float(m2 * varianceScale[i]);
         }
       }
+      for (size_t k = 0; k < count;
+           ++k) {  // M2_k = V_k n_k (n_k − 1), V_k its variance of the mean
+        const float* partMean = parts[k]->get(q).mean.data() + offset;
+        const float* partVariance = parts[k]->get(q).varianceOfMean.data() + offset;
+        for (size_t i = 0; i < size; ++i) {
+          if (!(weight[i * count + k] > 0)) continue;
+          const double n = samples[i * count + k];
+          for (size_t c = 0; c < channels; ++c) {
+            const size_t e = i * channels + c;
+            const double delta = double(partMean[e]) - mean[e];
+            m2[e] += (double(partVariance[e]) * (n - 1) + delta * delta) * n;
+          }
+        }
+      }
+      float* outMean = out.get(q).mean.data() + offset;
+      float* outVariance = out.get(q).varianceOfMean.data() + offset;
+      for (size_t i = 0; i < size; ++i)
+        for (size_t c = 0; c < channels; ++c) {
+          const size_t e = i * channels + c;
+          outMean[e] = float(mean[e]);
+          outVariance[e] = float(m2[e] * varianceScale[i]);
+        }
     }
   });
   return out;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "denoise/base/atrous_kernel.h"
+#include "denoise/base/buffer_variance.h"
 #include "denoise/base/input_planes.h"
 #include "denoise/image/padded_planes.h"
 #include "denoise/util/error.h"
@@ -258,10 +259,6 @@ void atrousLevel(const Guide& g, const AtrousParams& params, AtrousKernelPath pa
   });
 }
 
-inline float finiteOrZero(float v) {
-  return std::isfinite(v) ? v : 0.0f;
-}
-
 // Demodulation divisors, interleaved RGB like the albedo: max(albedo, 1e-3) (non-finite albedo
 // counts as 0) — except near a pixel whose albedo is (nearly) black in every channel, where they
 // are 1. With the chorus renderer's features an emitter seen directly records its material's
@@ -286,8 +283,9 @@ std::vector<float> demodulationDivisors(const SubBuffer& buffer, bool demodulate
     std::vector<char> black(size_t(w) + 2 * kEmitterGuard, 0);  // with a guard band each side
     const float* a = albedo + size_t(y) * size_t(w) * 3;
     for (int x = 0; x < w; ++x) {
-      const float brightest = std::max(std::max(0.0f, finiteOrZero(a[3 * x])),
-                                       std::max(finiteOrZero(a[3 * x + 1]), finiteOrZero(a[3 * x + 2])));
+      const float brightest =
+          std::max(std::max(0.0f, finiteOrZero(a[3 * x])),
+                   std::max(finiteOrZero(a[3 * x + 1]), finiteOrZero(a[3 * x + 2])));
       black[size_t(x + kEmitterGuard)] = brightest < kEmitterAlbedo;
     }
     char* row = nearBlack.data() + size_t(y) * size_t(w);

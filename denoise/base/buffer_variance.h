@@ -3,6 +3,7 @@
 // applies to variances and features (../shared/docs/base-denoisers.md §0, §3). All images are
 // interleaved float images of one size; every function returns finite values (non-finite inputs
 // count as missing).
+#include <cmath>
 #include <cstdint>
 #include <initializer_list>
 #include <vector>
@@ -18,6 +19,11 @@ inline constexpr float kNeutralVariance = 1e30f;
 
 // Copy of `image` with NaN/Inf replaced by `replacement`.
 Image finiteOr(const Image& image, float replacement);
+
+// One value: itself when finite, else 0.
+inline float finiteOrZero(float v) {
+  return std::isfinite(v) ? v : 0.0f;
+}
 
 // Per pixel: 1 where every channel of every listed image is finite, else 0.
 std::vector<uint8_t> finiteMask(std::initializer_list<const Image*> images);

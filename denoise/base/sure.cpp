@@ -4,13 +4,9 @@
 #include <limits>
 #include <stdexcept>
 
-namespace chorus {
+#include "denoise/base/buffer_variance.h"
 
-namespace {
-float finiteOrZero(float v) {
-  return std::isfinite(v) ? v : 0.0f;
-}
-}  // namespace
+namespace chorus {
 
 Image sureMap(const Image& filtered, const Image& noisy, const Image& variance,
               const Image& derivative) {

@@ -19,13 +19,16 @@ void checkImage(const Image& image, const std::string& what, const Image& like) 
                 "x" + std::to_string(like.height()) + "x3");
 }
 
-}  // namespace
-
-EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers) {
-  const int k = buffers.splitCount();
+void checkSplitCount(int k) {
   if (k < 2 || k % 2 != 0)
     throw Error("the ensemble needs an even number of independent sub-buffers (2 or 4), got " +
                 std::to_string(k));
+}
+
+}  // namespace
+
+EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers) {
+  checkSplitCount(buffers.splitCount());
   EnsembleSources sources{buffers.input(BufferPart::HalfA), buffers.input(BufferPart::HalfB), {}};
   // The full buffer's halves are the half inputs' wholes: copied rather than merged again.
   sources.full.whole = buffers.part(BufferPart::Full);
@@ -34,17 +37,19 @@ EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers) {
 }
 
 EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull) {
-  if (buffers.splitCount() != 2) {
-    EnsembleSources sources = sourcesFromBuffers(buffers);
-    if (!halvesOfFull) sources.full.halves.reset();
-    buffers = {};
-    return sources;
-  }
+  const int k = buffers.splitCount();
+  checkSplitCount(k);
   EnsembleSources sources;
   sources.full.whole = buffers.part(BufferPart::Full);
-  if (halvesOfFull) sources.full.halves = std::array<SubBuffer, 2>{buffers.sub(0), buffers.sub(1)};
-  sources.a.whole = std::move(buffers.sub(0));
-  sources.b.whole = std::move(buffers.sub(1));
+  if (k == 2) {  // the halves are the two sub-buffers themselves: moved, not copied
+    sources.a.whole = std::move(buffers.sub(0));
+    sources.b.whole = std::move(buffers.sub(1));
+  } else {
+    sources.a = buffers.input(BufferPart::HalfA);
+    sources.b = buffers.input(BufferPart::HalfB);
+  }
+  if (halvesOfFull)
+    sources.full.halves = std::array<SubBuffer, 2>{sources.a.whole, sources.b.whole};
   buffers = {};
   return sources;
 }

@@ -48,7 +48,15 @@ struct TileMemory {
   // candidate and channel of y(p): Σ ∂w, Σ ∂w y(q), ∂(max w).
   std::vector<float> weightSum[3], maxWeight[3], acc[3];
   std::vector<float> derivativeSum[kColor], derivativeAcc[kColor], maxDerivative[kColor];
+  size_t planeStride = 0;  // between the planes of acc and of the derivative sums
 };
+
+// A tile's area is a multiple of 4 KiB: planes that far apart share L1 sets (and alias in the
+// store buffer), and the accumulation touches dozens of them per pixel. One cache line more
+// per plane spreads them over the sets (−10% RDFC time at 768², one thread).
+size_t paddedPlaneStride(size_t area) {
+  return area + 16;
+}
 
 class CandidateKernel {
  public:
@@ -310,7 +318,6 @@ void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, Tile
 
 void CandidateKernel::accumulate(const PixelRect& tile, int dx, int dy, TileMemory& m) const {
   const int tw = tile.width(), x0 = tile.x0;
-  const size_t area = size_t(tile.area());
   const int adx = std::abs(dx), ady = std::abs(dy);
   for (int y = tile.y0; y < tile.y1; ++y) {
     const size_t row = size_t(y - tile.y0) * size_t(tw);
@@ -321,7 +328,7 @@ void CandidateKernel::accumulate(const PixelRect& tile, int dx, int dy, TileMemo
       sums.dataMinus[c] = b1_.row(c, y - dy) + x0 - dx;
       sums.dataMinus[3 + c] = b2_.row(c, y - dy) + x0 - dx;
     }
-    sums.accStride = area;
+    sums.accStride = m.planeStride;
     auto candidateSums = [&](int s) {
       sums.weightSum = m.weightSum[s].data() + row;
       sums.maxWeight = m.maxWeight[s].data() + row;
@@ -354,14 +361,14 @@ void CandidateKernel::accumulate(const PixelRect& tile, int dx, int dy, TileMemo
       r.derivativeSum = m.derivativeSum[s].data() + row;
       r.derivativeAcc = m.derivativeAcc[s].data() + row;
       r.maxDerivative = m.maxDerivative[s].data() + row;
-      r.derivativeStride = area;
+      r.derivativeStride = m.planeStride;
       rows::accumulateColorCandidate(tw, r, refineMinWeight_, candidateSums(s));
     }
   }
 }
 
 void CandidateKernel::finishTile(const PixelRect& tile, const TileMemory& m, Outputs& out) const {
-  const size_t area = size_t(tile.area());
+  const size_t stride = m.planeStride;
   for (int y = tile.y0; y < tile.y1; ++y)
     for (int x = tile.x0; x < tile.x1; ++x) {
       const size_t i = size_t(y - tile.y0) * size_t(tile.width()) + size_t(x - tile.x0);
@@ -370,8 +377,8 @@ void CandidateKernel::finishTile(const PixelRect& tile, const TileMemory& m, Out
         const float total = m.weightSum[s][i] + centre;
         float mean[3];
         for (int c = 0; c < 3; ++c) {
-          const float f1 = (m.acc[s][size_t(c) * area + i] + centre * b1_.row(c, y)[x]) / total;
-          const float f2 = (m.acc[s][size_t(3 + c) * area + i] + centre * b2_.row(c, y)[x]) / total;
+          const float f1 = (m.acc[s][size_t(c) * stride + i] + centre * b1_.row(c, y)[x]) / total;
+          const float f2 = (m.acc[s][size_t(3 + c) * stride + i] + centre * b2_.row(c, y)[x]) / total;
           out.buffer1[size_t(s)](x, y, c) = f1;
           out.buffer2[size_t(s)](x, y, c) = f2;
           mean[c] = 0.5f * (f1 + f2);
@@ -382,7 +389,7 @@ void CandidateKernel::finishTile(const PixelRect& tile, const TileMemory& m, Out
         if (s < kColor) {
           bool valid = true;
           for (int c = 0; c < 3 && valid; ++c) {
-            const size_t k = size_t(c) * area + i;
+            const size_t k = size_t(c) * stride + i;
             const float dCentre =
                 m.maxWeight[s][i] >= kMinCenterWeight ? m.maxDerivative[s][k] : 0.0f;
             const float dSum = m.derivativeSum[s][k] + dCentre;
@@ -402,10 +409,12 @@ void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out
   const FlushDenormals flush;  // tiny weights times data would be denormal
   const size_t area = size_t(tile.area());
   const size_t grownArea = size_t(kTileWidth + 2 * grow_) * size_t(kTileHeight + 2 * grow_);
+  m.planeStride = paddedPlaneStride(area);
+  const size_t plane = m.planeStride;  // every plane's allocation, so that they too are staggered
   m.ones.assign(area, 1.0f);
   for (int set = 0; set < 2; ++set) {
-    m.featPlus[set].resize(area);
-    m.featMinus[set].resize(area);
+    m.featPlus[set].resize(plane);
+    m.featMinus[set].resize(plane);
   }
   for (auto& v : m.ext) v.resize(grownArea);
   m.rowSums.resize(size_t(kTileWidth) * size_t(kTileHeight + 2 * grow_));
@@ -416,27 +425,27 @@ void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out
   for (int s = 0; s < kColor; ++s) {
     const float inv = 1.0f / float(2 * patch_[s] + 1);
     m.fullInvCountX[s].assign(kTileWidth, inv);
-    m.fullInvCount[s].assign(area, inv * inv);
+    m.fullInvCount[s].assign(plane, inv * inv);
   }
   for (int s = 0; s < kColor; ++s)
     for (int kind = 0; kind < 3; ++kind) {
-      m.dist[s][kind].resize(area);
-      m.invCountStore[s][kind].resize(area);
+      m.dist[s][kind].resize(plane);
+      m.invCountStore[s][kind].resize(plane);
     }
   for (int c = 0; c < 3; ++c)
     for (int kind = 0; kind < 3; ++kind) {
-      m.slope[c][kind].resize(area);
-      m.nearSlope[c][kind].resize(area);
+      m.slope[c][kind].resize(plane);
+      m.nearSlope[c][kind].resize(plane);
     }
   for (int s = 0; s < 3; ++s) {
-    m.weightSum[s].assign(area, 0.0f);
-    m.maxWeight[s].assign(area, 0.0f);
-    m.acc[s].assign(6 * area, 0.0f);
+    m.weightSum[s].assign(plane, 0.0f);
+    m.maxWeight[s].assign(plane, 0.0f);
+    m.acc[s].assign(6 * plane, 0.0f);
   }
   for (int s = 0; s < kColor; ++s) {
-    m.derivativeSum[s].assign(3 * area, 0.0f);
-    m.derivativeAcc[s].assign(3 * area, 0.0f);
-    m.maxDerivative[s].assign(3 * area, 0.0f);
+    m.derivativeSum[s].assign(3 * plane, 0.0f);
+    m.derivativeAcc[s].assign(3 * plane, 0.0f);
+    m.maxDerivative[s].assign(3 * plane, 0.0f);
   }
   for (int dy = 0; dy <= params_.r; ++dy)
     for (int dx = dy == 0 ? 1 : -params_.r; dx <= params_.r; ++dx) {

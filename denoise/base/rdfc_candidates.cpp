@@ -22,10 +22,10 @@ namespace {
 // Wide, short tiles: each row-kernel call covers 256 pixels, which spreads the per-call overhead,
 // and the rows read at p ± δ for one dy (in every plane) stay in L2 across the dx loop
 // (candidates 24.6 CPU s/Mpx at 128 × 16, 21.8 at 256 × 8, 22.0 at 512 × 8, 23.1 at 128 × 8 and
-// at 256 × 4 on the synthetic 512² case). 32 rows rather than 8 or 16 since the accumulation is
-// fused: the colour distances and patch sums of the 2 · 3 margin rows are a sixth of the grown
-// tile rather than a third or half (−5% candidate instructions from 8 to 16, −2.6% from 16 to 32).
-constexpr int kTileWidth = 256, kTileHeight = 32;
+// at 256 × 4 on the synthetic 512² case). 16 rows: the margin rows' colour distances and patch
+// sums favour taller tiles (−2.6% instructions from 16 to 32), but the tile's ~80 planes then
+// outgrow L2 (32 rows 2–4% slower in A/B runs, 8 rows 1–3%).
+constexpr int kTileWidth = 256, kTileHeight = 16;
 constexpr float kMinCenterWeight = 1e-3f;  // the release's WEIGHT_EPSILON
 constexpr float kSymmetricLimit = 25.0f;   // refine only where both distances are below this
 constexpr int kColor = 2;                  // FIRST and SECOND have a colour term

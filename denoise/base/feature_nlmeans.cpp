@@ -12,6 +12,7 @@
 #include "denoise/base/nlmeans_row_kernels.h"
 #include "denoise/base/rect_mask.h"
 #include "denoise/util/float_lanes.h"
+#include "denoise/util/padded_stride.h"
 #include "denoise/util/parallel_rows.h"
 
 namespace chorus {
@@ -66,6 +67,7 @@ struct TileMemory {
   std::vector<float> patchPlus, patchMinus, wPlus, wMinus;
   std::vector<float> weightSum, maxWeight;
   std::vector<float> acc;  // every data channel, one plane each
+  size_t planeStride = 0;  // of acc, and every tile plane's allocation (staggered)
 };
 
 class FeatureNlMeansKernel {
@@ -319,13 +321,15 @@ void FeatureNlMeansKernel::runTile(const PixelRect& tile, TileMemory& m,
   for (auto& v : m.ext) v.resize(extArea);
   for (auto& v : m.dist) v.resize(gridArea);
   for (auto& v : m.gridMaskStore) v.resize(extArea);
+  m.planeStride = paddedPlaneStride(area);
+  const size_t plane = m.planeStride;
   for (auto* v : {&m.featPlus, &m.featMinus, &m.patchPlus, &m.patchMinus, &m.wPlus, &m.wMinus})
-    v->resize(area);
-  m.gridPlus.resize(gridArea);
-  m.gridMinus.resize(gridArea);
-  m.weightSum.assign(area, 0.0f);
-  m.maxWeight.assign(area, 0.0f);
-  m.acc.assign(area * size_t(dataChannels_), 0.0f);
+    v->resize(plane);
+  m.gridPlus.resize(paddedPlaneStride(gridArea));
+  m.gridMinus.resize(paddedPlaneStride(gridArea));
+  m.weightSum.assign(plane, 0.0f);
+  m.maxWeight.assign(plane, 0.0f);
+  m.acc.assign(plane * size_t(dataChannels_), 0.0f);
 
   const int r = params_.r;
   for (int dy = 0; dy <= r; ++dy)
@@ -355,7 +359,7 @@ void FeatureNlMeansKernel::runTile(const PixelRect& tile, TileMemory& m,
         for (int k = 0; k < dataChannels_; ++k)
           rows::accumulateData(tw, wPlus + row, wMinus + row, data_.row(k, y + dy) + x0 + dx,
                                data_.row(k, y - dy) + x0 - dx,
-                               m.acc.data() + size_t(k) * area + row);
+                               m.acc.data() + size_t(k) * plane + row);
       }
     }
 
@@ -367,7 +371,7 @@ void FeatureNlMeansKernel::runTile(const PixelRect& tile, TileMemory& m,
       for (size_t d = 0; d + 1 < dataBegin_.size(); ++d)
         for (int c = 0; c < dataBegin_[d + 1] - dataBegin_[d]; ++c) {
           const int k = dataBegin_[d] + c;
-          out[d](x, y, c) = (m.acc[size_t(k) * area + i] + centre * data_.row(k, y)[x]) / total;
+          out[d](x, y, c) = (m.acc[size_t(k) * plane + i] + centre * data_.row(k, y)[x]) / total;
         }
     }
 }

@@ -14,6 +14,7 @@
 #include "denoise/base/rect_mask.h"
 #include "denoise/base/sure.h"
 #include "denoise/util/float_lanes.h"
+#include "denoise/util/padded_stride.h"
 #include "denoise/util/parallel_rows.h"
 
 namespace chorus {
@@ -51,12 +52,6 @@ struct TileMemory {
   size_t planeStride = 0;  // between the planes of acc and of the derivative sums
 };
 
-// A tile's area is a multiple of 4 KiB: planes that far apart share L1 sets (and alias in the
-// store buffer), and the accumulation touches dozens of them per pixel. One cache line more
-// per plane spreads them over the sets (−10% RDFC time at 768², one thread).
-size_t paddedPlaneStride(size_t area) {
-  return area + 16;
-}
 
 class CandidateKernel {
  public:

@@ -155,7 +155,8 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& r
     }
 
     // Continue the path by sampling the BSDF.
-    const auto bs = bsdf.sample(woLocal, sampler.get1DAt(dLobe), sampler.get2DAt(dDirection));
+    const float uLobe = bsdf.choosesLobe() ? sampler.get1DAt(dLobe) : 0.0f;
+    const auto bs = bsdf.sample(woLocal, uLobe, sampler.get2DAt(dDirection));
     if (!bs || !(bs->pdf > 0) || bs->f.isBlack()) break;
     const Vec3f wi = frame.fromLocal(bs->wi);
     // Reject directions whose side of the geometric surface contradicts the lobe (possible

@@ -23,7 +23,10 @@ bool known(const std::vector<uint8_t>* mask, size_t pixel) {
 
 Image finiteOr(const Image& image, float replacement) {
   Image out = image;
-  for (float& v : out.values()) v = std::isfinite(v) ? v : replacement;
+  float* values = out.data();
+  parallelChunks(out.size(), [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) values[k] = std::isfinite(values[k]) ? values[k] : replacement;
+  });
   return out;
 }
 
@@ -43,22 +46,26 @@ std::vector<uint8_t> finiteMask(std::initializer_list<const Image*> images) {
 Image squaredDifference(const Image& a, const Image& b, float scale) {
   requireSameShape(a, b, "squaredDifference");
   Image out(a.width(), a.height(), a.channels());
-  for (size_t i = 0; i < a.size(); ++i) {
-    const float d = a.data()[i] - b.data()[i];
-    const float v = d * d * scale;
-    out.data()[i] = std::isfinite(v) ? v : 0.0f;
-  }
+  parallelChunks(a.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const float d = a.data()[i] - b.data()[i];
+      const float v = d * d * scale;
+      out.data()[i] = std::isfinite(v) ? v : 0.0f;
+    }
+  });
   return out;
 }
 
 Image completedVariance(const Image& sampleVariance, const Image& twoBuffer) {
   requireSameShape(sampleVariance, twoBuffer, "completedVariance");
   Image out(sampleVariance.width(), sampleVariance.height(), sampleVariance.channels());
-  for (size_t i = 0; i < out.size(); ++i) {
-    const float s = sampleVariance.data()[i], t = twoBuffer.data()[i];
-    const bool measured = std::isfinite(s) && s >= 0.0f && (s > 0.0f || !(t > 0.0f));
-    out.data()[i] = measured ? s : (std::isfinite(t) ? std::max(t, 0.0f) : 0.0f);
-  }
+  parallelChunks(out.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const float s = sampleVariance.data()[i], t = twoBuffer.data()[i];
+      const bool measured = std::isfinite(s) && s >= 0.0f && (s > 0.0f || !(t > 0.0f));
+      out.data()[i] = measured ? s : (std::isfinite(t) ? std::max(t, 0.0f) : 0.0f);
+    }
+  });
   return out;
 }
 
@@ -67,17 +74,20 @@ Image rescaledVariance(const Image& sampleVariance, const Image& twoBuffer, int 
   requireSameShape(sampleVariance, twoBuffer, "rescaledVariance");
   const int channels = sampleVariance.channels();
   Image sample = finiteOr(sampleVariance, 0.0f), buffer = finiteOr(twoBuffer, 0.0f);
-  for (size_t i = 0; i < sample.pixelCount(); ++i)
-    for (int c = 0; c < channels; ++c) {
-      const size_t k = i * size_t(channels) + size_t(c);
-      if (!known(mask, i)) sample.data()[k] = buffer.data()[k] = 0.0f;
-    }
+  if (mask)
+    for (size_t i = 0; i < sample.pixelCount(); ++i)
+      for (int c = 0; c < channels; ++c) {
+        const size_t k = i * size_t(channels) + size_t(c);
+        if (!known(mask, i)) sample.data()[k] = buffer.data()[k] = 0.0f;
+      }
   const Image sampleBox = boxFilter(sample, radius), bufferBox = boxFilter(buffer, radius);
   Image out(sample.width(), sample.height(), channels);
-  for (size_t k = 0; k < out.size(); ++k) {
-    const float v = sample.data()[k] * bufferBox.data()[k] / (1e-10f + sampleBox.data()[k]);
-    out.data()[k] = std::isfinite(v) && v > 0.0f ? v : 0.0f;
-  }
+  parallelChunks(out.size(), [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      const float v = sample.data()[k] * bufferBox.data()[k] / (1e-10f + sampleBox.data()[k]);
+      out.data()[k] = std::isfinite(v) && v > 0.0f ? v : 0.0f;
+    }
+  });
   return out;
 }
 

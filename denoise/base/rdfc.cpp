@@ -20,7 +20,9 @@ void requireRange(bool ok, const std::string& what) {
 
 Image average(const Image& a, const Image& b) {
   Image out(a.width(), a.height(), a.channels());
-  for (size_t k = 0; k < out.size(); ++k) out.data()[k] = 0.5f * (a.data()[k] + b.data()[k]);
+  parallelChunks(out.size(), [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) out.data()[k] = 0.5f * (a.data()[k] + b.data()[k]);
+  });
   return out;
 }
 
@@ -187,8 +189,10 @@ RdfcResult runRdfc(const DenoiseInput& input, const RdfcParams& params) {
 
   // 5. Second pass.
   result.output = secondPass(first1, first2, features, params);
-  for (size_t k = 0; k < result.output.size(); ++k)
-    if (!std::isfinite(result.output.data()[k])) result.output.data()[k] = guide.data()[k];
+  parallelChunks(result.output.size(), [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k)
+      if (!std::isfinite(result.output.data()[k])) result.output.data()[k] = guide.data()[k];
+  });
   return result;
 }
 

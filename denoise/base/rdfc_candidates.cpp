@@ -100,8 +100,9 @@ CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& 
   grow_ = std::max(params.fFirst, params.fSecond);
   pad_ = 2 * params.r + grow_ + 1;
   guide_ = Image(width_, height_, 3);
-  for (size_t k = 0; k < guide_.size(); ++k)
-    guide_.data()[k] = 0.5f * (b1.data()[k] + b2.data()[k]);
+  parallelChunks(guide_.size(), [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) guide_.data()[k] = 0.5f * (b1.data()[k] + b2.data()[k]);
+  });
   for (BorderedPlanes* p : {&b1_, &b2_, &g_, &vn_, &vd_}) *p = BorderedPlanes(width_, height_, 3, pad_);
   for (int c = 0; c < 3; ++c) {
     b1_.set(c, b1, c, 1.0f);

@@ -101,10 +101,12 @@ Image RdfcFeature::normalizingVariance(float tau) const {
   Image out(variance.width(), variance.height(), variance.channels());
   const float floor = tau * tauScale;
   const size_t channels = size_t(variance.channels());
-  for (size_t k = 0; k < out.size(); ++k)
-    out.data()[k] = known[k / channels]
-                        ? std::max(variance.data()[k], std::max(gradient.data()[k], floor))
-                        : kNeutralVariance;
+  parallelChunks(out.size(), [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k)
+      out.data()[k] = known[k / channels]
+                          ? std::max(variance.data()[k], std::max(gradient.data()[k], floor))
+                          : kNeutralVariance;
+  });
   return out;
 }
 

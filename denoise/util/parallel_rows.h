@@ -7,6 +7,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <cstddef>
+
 #if defined(__SSE2__)
 #include <xmmintrin.h>
 #endif
@@ -26,6 +29,19 @@ void parallelRows(int begin, int end, const Body& body) {
 #else
   tbb::parallel_for(begin, end, body);
 #endif
+}
+
+// body(begin, end) for consecutive ranges covering [0, count), in parallel (parallelRows on
+// chunks): element-wise loops over whole images, which are serial time between the filters'
+// parallel loops otherwise.
+template <typename Body>
+void parallelChunks(size_t count, const Body& body) {
+  constexpr size_t kChunk = size_t(1) << 15;
+  const size_t chunks = (count + kChunk - 1) / kChunk;
+  parallelRows(0, int(chunks), [&](int chunk) {
+    const size_t begin = size_t(chunk) * kChunk;
+    body(begin, std::min(count, begin + kChunk));
+  });
 }
 
 }  // namespace chorus

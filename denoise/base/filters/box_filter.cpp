@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "denoise/image/planar_image.h"
+#include "denoise/util/parallel_rows.h"
 #include "denoise/util/simd_clones.h"
 
 // The row and column kernels are built for AVX-512F, AVX2 and the baseline (simd_clones.h),
@@ -213,9 +214,11 @@ void boxFilterPlane(const float* src, float* dst, int width, int height, int rad
 
 Image boxFilter(const Image& image, int radius) {
   PlanarImage planes(image);
-  std::vector<float> tmp;
-  for (int c = 0; c < planes.channels(); ++c)
+  // The channels side by side (each plane is filtered alone, so the results do not change).
+  parallelRows(0, planes.channels(), [&](int c) {
+    std::vector<float> tmp;
     boxFilterPlane(planes.plane(c), planes.plane(c), planes.width(), planes.height(), radius, tmp);
+  });
   return planes.toImage();
 }
 

@@ -146,14 +146,15 @@ FeatureNlMeansKernel::FeatureNlMeansKernel(std::span<const Image* const> data,
     for (int c = 0; c < data[i]->channels(); ++c) data_.set(dataBegin_[i] + c, *data[i], c);
 
   if (hasPatch_) {
-    g_ = vn_ = vd_ = BorderedPlanes(width_, height_, patchChannels_, pad_);
+    for (BorderedPlanes* p : {&g_, &vn_, &vd_}) *p = BorderedPlanes(width_, height_, patchChannels_, pad_);
     for (int c = 0; c < patchChannels_; ++c) {
       g_.set(c, *patch->guide, c);
       vn_.set(c, *patch->variance, c, patch->alpha);
       vd_.set(c, *patch->variance, c, patch->k * patch->k);
     }
     if (patchCentreOnly_) {
-      invPair_ = invSym_ = BorderedPlanes(width_, height_, patchChannels_, pad_);
+      for (BorderedPlanes* p : {&invPair_, &invSym_})
+        *p = BorderedPlanes(width_, height_, patchChannels_, pad_);
       for (int c = 0; c < patchChannels_; ++c)
         parallelRows(-pad_, height_ + pad_, [&](int y) {
           rows::centreReciprocals(width_ + 2 * pad_, vd_.row(c, y) - pad_,
@@ -169,7 +170,7 @@ FeatureNlMeansKernel::FeatureNlMeansKernel(std::span<const Image* const> data,
     channels += t.value->channels();
   }
   termBegin_.push_back(channels);
-  fValue_ = fNum_ = fDen_ = BorderedPlanes(width_, height_, channels, pad_);
+  for (BorderedPlanes* p : {&fValue_, &fNum_, &fDen_}) *p = BorderedPlanes(width_, height_, channels, pad_);
   for (size_t j = 0; j < features.size(); ++j) {
     const FeatureTerm& t = features[j];
     const Image& den = t.normalizingVariance ? *t.normalizingVariance : *t.variance;

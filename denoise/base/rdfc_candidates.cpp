@@ -120,9 +120,7 @@ CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& 
     channels += f.value.channels();
   }
   termBegin_.push_back(channels);
-  fValue_ = BorderedPlanes(width_, height_, channels, pad_);
-  fNum_ = BorderedPlanes(width_, height_, channels, pad_);
-  fDen_ = BorderedPlanes(width_, height_, channels, pad_);
+  for (BorderedPlanes* p : {&fValue_, &fNum_, &fDen_}) *p = BorderedPlanes(width_, height_, channels, pad_);
   const float kf2 = params.kf * params.kf;
   for (size_t j = 0; j < features.size(); ++j) {
     const RdfcFeature& f = features[j];

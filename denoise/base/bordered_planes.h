@@ -22,8 +22,9 @@ class BorderedPlanes {
         planeSize_(stride_ * size_t(height + 2 * pad)),
         data_(new float[planeSize_ * size_t(channels)]) {
     float* values = data_.get();
-    parallelChunks(planeSize_ * size_t(channels),
-                   [&](size_t begin, size_t end) { std::fill(values + begin, values + end, 0.0f); });
+    parallelChunks(planeSize_ * size_t(channels), [&](size_t begin, size_t end) {
+      std::fill(values + begin, values + end, 0.0f);
+    });
   }
   // Channel c of this ← channel sourceChannel of image × scale (rows in parallel: the filters
   // set up dozens of planes before their parallel loops).

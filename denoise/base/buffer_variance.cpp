@@ -25,7 +25,8 @@ Image finiteOr(const Image& image, float replacement) {
   Image out = image;
   float* values = out.data();
   parallelChunks(out.size(), [&](size_t begin, size_t end) {
-    for (size_t k = begin; k < end; ++k) values[k] = std::isfinite(values[k]) ? values[k] : replacement;
+    for (size_t k = begin; k < end; ++k)
+      values[k] = std::isfinite(values[k]) ? values[k] : replacement;
   });
   return out;
 }

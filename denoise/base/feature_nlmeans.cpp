@@ -68,8 +68,7 @@ struct TileMemory {
   std::vector<float> ext[3], dist[3], gridMaskStore[3], gridPlus, gridMinus, rowSums, invX;
   std::vector<float> patchPlus, patchMinus, wPlus, wMinus;
   std::vector<float> weightSum, maxWeight;
-  std::vector<float> acc;  // every data channel, one plane each
-  size_t planeStride = 0;  // of acc, and every tile plane's allocation (staggered)
+  std::vector<float> acc;  // every data channel, one plane each (paddedPlaneStride apart)
 };
 
 class FeatureNlMeansKernel {
@@ -148,7 +147,8 @@ FeatureNlMeansKernel::FeatureNlMeansKernel(std::span<const Image* const> data,
     for (int c = 0; c < data[i]->channels(); ++c) data_.set(dataBegin_[i] + c, *data[i], c);
 
   if (hasPatch_) {
-    for (BorderedPlanes* p : {&g_, &vn_, &vd_}) *p = BorderedPlanes(width_, height_, patchChannels_, pad_);
+    for (BorderedPlanes* p : {&g_, &vn_, &vd_})
+      *p = BorderedPlanes(width_, height_, patchChannels_, pad_);
     for (int c = 0; c < patchChannels_; ++c) {
       g_.set(c, *patch->guide, c);
       vn_.set(c, *patch->variance, c, patch->alpha);
@@ -172,7 +172,8 @@ FeatureNlMeansKernel::FeatureNlMeansKernel(std::span<const Image* const> data,
     channels += t.value->channels();
   }
   termBegin_.push_back(channels);
-  for (BorderedPlanes* p : {&fValue_, &fNum_, &fDen_}) *p = BorderedPlanes(width_, height_, channels, pad_);
+  for (BorderedPlanes* p : {&fValue_, &fNum_, &fDen_})
+    *p = BorderedPlanes(width_, height_, channels, pad_);
   for (size_t j = 0; j < features.size(); ++j) {
     const FeatureTerm& t = features[j];
     const Image& den = t.normalizingVariance ? *t.normalizingVariance : *t.variance;
@@ -215,10 +216,8 @@ void FeatureNlMeansKernel::featureWeights(const PixelRect& tile, int dx, int dy,
                            m.featPlus.data() + row, m.featMinus.data() + row);
     }
   }
-  if (m.mask[kPlus] != m.ones.data())
-    for (size_t i = 0; i < area; ++i) m.featPlus[i] *= m.mask[kPlus][i];
-  if (m.mask[kMinus] != m.ones.data())
-    for (size_t i = 0; i < area; ++i) m.featMinus[i] *= m.mask[kMinus][i];
+  multiplyByMask(m.featPlus.data(), area, m.mask[kPlus], m.ones.data());
+  multiplyByMask(m.featMinus.data(), area, m.mask[kMinus], m.ones.data());
 }
 
 void FeatureNlMeansKernel::unrefinedFeatureWeights(const PixelRect& tile, int dx, int dy,
@@ -271,14 +270,12 @@ void FeatureNlMeansKernel::patchWeights(const PixelRect& tile, int dx, int dy,
             m.ext[kMinus].data() + e, m.ext[kSym].data() + e);
         continue;
       }
-      const float* vd = vd_.row(c, y) + ox;
       rows::addColorDistances(
           ew, g_.row(c, y) + ox, g_.row(c, y + dy) + ox + dx, g_.row(c, y - dy) + ox - dx,
-          vn_.row(c, y) + ox, vn_.row(c, y + dy) + ox + dx, vn_.row(c, y - dy) + ox - dx, vd,
-          patchCentreOnly_ ? vd : vd_.row(c, y + dy) + ox + dx,
-          patchCentreOnly_ ? vd : vd_.row(c, y - dy) + ox - dx, share,
-          patchCentreOnly_ ? 0.5f : 0.25f, c == 0, m.ext[kPlus].data() + e,
-          m.ext[kMinus].data() + e, m.ext[kSym].data() + e, nullptr, nullptr, nullptr);
+          vn_.row(c, y) + ox, vn_.row(c, y + dy) + ox + dx, vn_.row(c, y - dy) + ox - dx,
+          vd_.row(c, y) + ox, vd_.row(c, y + dy) + ox + dx, vd_.row(c, y - dy) + ox - dx, share,
+          0.25f, c == 0, m.ext[kPlus].data() + e, m.ext[kMinus].data() + e,
+          m.ext[kSym].data() + e, nullptr, nullptr, nullptr);
     }
   }
   // Patch means over the grid (the tile grown by the weight box), counting valid pixels only.
@@ -324,8 +321,7 @@ void FeatureNlMeansKernel::runTile(const PixelRect& tile, TileMemory& m,
   for (auto& v : m.ext) v.resize(extArea);
   for (auto& v : m.dist) v.resize(gridArea);
   for (auto& v : m.gridMaskStore) v.resize(extArea);
-  m.planeStride = paddedPlaneStride(area);
-  const size_t plane = m.planeStride;
+  const size_t plane = paddedPlaneStride(area);  // every tile plane's allocation (staggered)
   for (auto* v : {&m.featPlus, &m.featMinus, &m.patchPlus, &m.patchMinus, &m.wPlus, &m.wMinus})
     v->resize(plane);
   m.gridPlus.resize(paddedPlaneStride(gridArea));

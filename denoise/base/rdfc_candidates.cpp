@@ -52,7 +52,6 @@ struct TileMemory {
   size_t planeStride = 0;  // between the planes of acc and of the derivative sums
 };
 
-
 class CandidateKernel {
  public:
   CandidateKernel(const Image& b1, const Image& b2, const Image& variance,
@@ -103,7 +102,8 @@ CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& 
   parallelChunks(guide_.size(), [&](size_t begin, size_t end) {
     for (size_t k = begin; k < end; ++k) guide_.data()[k] = 0.5f * (b1.data()[k] + b2.data()[k]);
   });
-  for (BorderedPlanes* p : {&b1_, &b2_, &g_, &vn_, &vd_}) *p = BorderedPlanes(width_, height_, 3, pad_);
+  for (BorderedPlanes* p : {&b1_, &b2_, &g_, &vn_, &vd_})
+    *p = BorderedPlanes(width_, height_, 3, pad_);
   for (int c = 0; c < 3; ++c) {
     b1_.set(c, b1, c, 1.0f);
     b2_.set(c, b2, c, 1.0f);
@@ -120,7 +120,8 @@ CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& 
     channels += f.value.channels();
   }
   termBegin_.push_back(channels);
-  for (BorderedPlanes* p : {&fValue_, &fNum_, &fDen_}) *p = BorderedPlanes(width_, height_, channels, pad_);
+  for (BorderedPlanes* p : {&fValue_, &fNum_, &fDen_})
+    *p = BorderedPlanes(width_, height_, channels, pad_);
   const float kf2 = params.kf * params.kf;
   for (size_t j = 0; j < features.size(); ++j) {
     const RdfcFeature& f = features[j];
@@ -170,10 +171,8 @@ void CandidateKernel::featureWeights(const PixelRect& tile, int dx, int dy, Tile
     }
   }
   for (int set = 0; set < 2; ++set) {
-    if (m.mask[kPlus] != m.ones.data())
-      for (size_t i = 0; i < area; ++i) m.featPlus[set][i] *= m.mask[kPlus][i];
-    if (m.mask[kMinus] != m.ones.data())
-      for (size_t i = 0; i < area; ++i) m.featMinus[set][i] *= m.mask[kMinus][i];
+    multiplyByMask(m.featPlus[set].data(), area, m.mask[kPlus], m.ones.data());
+    multiplyByMask(m.featMinus[set].data(), area, m.mask[kMinus], m.ones.data());
   }
 }
 
@@ -371,8 +370,9 @@ void CandidateKernel::finishTile(const PixelRect& tile, const TileMemory& m, Out
         const float total = m.weightSum[s][i] + centre;
         float mean[3];
         for (int c = 0; c < 3; ++c) {
-          const float f1 = (m.acc[s][size_t(c) * stride + i] + centre * b1_.row(c, y)[x]) / total;
-          const float f2 = (m.acc[s][size_t(3 + c) * stride + i] + centre * b2_.row(c, y)[x]) / total;
+          const float* acc = m.acc[s].data() + i;
+          const float f1 = (acc[size_t(c) * stride] + centre * b1_.row(c, y)[x]) / total;
+          const float f2 = (acc[size_t(3 + c) * stride] + centre * b2_.row(c, y)[x]) / total;
           out.buffer1[size_t(s)](x, y, c) = f1;
           out.buffer2[size_t(s)](x, y, c) = f2;
           mean[c] = 0.5f * (f1 + f2);

@@ -32,4 +32,10 @@ inline const float* rectMaskOrOnes(const PixelRect& area, const PixelRect& valid
   return storage.data();
 }
 
+// values[i] *= mask[i] for i < n, skipped when mask is rectMaskOrOnes' `ones`.
+inline void multiplyByMask(float* values, size_t n, const float* mask, const float* ones) {
+  if (mask == ones) return;
+  for (size_t i = 0; i < n; ++i) values[i] *= mask[i];
+}
+
 }  // namespace chorus

@@ -479,24 +479,29 @@ void nearColorSlopes(int n, const float* __restrict g, const float* __restrict g
   }
 }
 
+namespace {
+
 // The candidate kernels take their many row pointers in structs: copied to locals, with ivdep
-// (the rows of one call never overlap) so that GCC vectorises without alias checks.
-ROW_KERNEL
-void accumulateCandidate(int n, const float* __restrict wPlus, const float* __restrict wMinus,
-                         const CandidateSums& sums) {
+// (the rows of one call never overlap) so that GCC vectorises without alias checks. SumsRow is
+// a candidate's sums so copied, with the per-pixel update both kernels end with.
+struct SumsRow {
   const float* up[6];
   const float* um[6];
-  for (int k = 0; k < 6; ++k) {
-    up[k] = sums.dataPlus[k];
-    um[k] = sums.dataMinus[k];
+  float* weightSum;
+  float* maxWeight;
+  float* acc;
+  size_t stride;
+
+  explicit SumsRow(const CandidateSums& sums)
+      : weightSum(sums.weightSum), maxWeight(sums.maxWeight), acc(sums.acc),
+        stride(sums.accStride) {
+    for (int k = 0; k < 6; ++k) {
+      up[k] = sums.dataPlus[k];
+      um[k] = sums.dataMinus[k];
+    }
   }
-  float* __restrict weightSum = sums.weightSum;
-  float* __restrict maxWeight = sums.maxWeight;
-  float* __restrict acc = sums.acc;
-  const size_t stride = sums.accStride;
-#pragma GCC ivdep
-  for (int i = 0; i < n; ++i) {
-    const float v1 = wPlus[i], v2 = wMinus[i];
+  // Σw, max w and Σ w u with the weights v1, v2 of p + δ and p − δ.
+  void add(int i, float v1, float v2) const {
     weightSum[i] += v1 + v2;
     maxWeight[i] = std::max(maxWeight[i], std::max(v1, v2));
 #pragma GCC unroll 6
@@ -505,6 +510,16 @@ void accumulateCandidate(int n, const float* __restrict wPlus, const float* __re
       a += v1 * up[k][i] + v2 * um[k][i];
     }
   }
+};
+
+}  // namespace
+
+ROW_KERNEL
+void accumulateCandidate(int n, const float* __restrict wPlus, const float* __restrict wMinus,
+                         const CandidateSums& sums) {
+  const SumsRow out(sums);
+#pragma GCC ivdep
+  for (int i = 0; i < n; ++i) out.add(i, wPlus[i], wMinus[i]);
 }
 
 template <bool Near>
@@ -537,16 +552,7 @@ ROW_KERNEL void accumulateColorCandidateOf(int n, const ColorCandidateRow& row,
   float* __restrict derivativeAcc = row.derivativeAcc;
   float* __restrict maxDerivative = row.maxDerivative;
   const size_t dStride = row.derivativeStride;
-  const float* up[6];
-  const float* um[6];
-  for (int k = 0; k < 6; ++k) {
-    up[k] = sums.dataPlus[k];
-    um[k] = sums.dataMinus[k];
-  }
-  float* __restrict weightSum = sums.weightSum;
-  float* __restrict maxWeight = sums.maxWeight;
-  float* __restrict acc = sums.acc;
-  const size_t stride = sums.accStride;
+  const SumsRow out(sums);
 #pragma GCC ivdep
   for (int i = 0; i < n; ++i) {
     // The weights and the terms of their derivatives.
@@ -558,7 +564,7 @@ ROW_KERNEL void accumulateColorCandidateOf(int n, const ColorCandidateRow& row,
     const float a = refineFactorOf(t, w1, w2, maskSym[i], minRefineWeight);
     const float r1 = a * ws + (1.0f - a) * w1, r2 = a * ws + (1.0f - a) * w2;
     const float v1 = std::min(r1, fPlus[i]), v2 = std::min(r2, fMinus[i]);
-    const float m = maxWeight[i];
+    const float m = out.maxWeight[i];
     const float pick2 = float((v2 > m) & (v2 > v1));
     // ∂w / ∂D · (1 / patch count): −w where 0 < D < 87, else 0
     const float k1 = -w1 * invCountPlus[i] * float(dPlus[i] > 0.0f);
@@ -589,14 +595,7 @@ ROW_KERNEL void accumulateColorCandidateOf(int n, const ColorCandidateRow& row,
       derivativeAcc[k] += dv1 * gPlus[c][i] + dv2 * gMinus[c][i];
       maxDerivative[k] = pick2 * dv2 + pick1 * dv1 + (1.0f - pick1 - pick2) * maxDerivative[k];
     }
-    // The sums.
-    weightSum[i] += v1 + v2;
-    maxWeight[i] = std::max(maxWeight[i], std::max(v1, v2));
-#pragma GCC unroll 6
-    for (int k = 0; k < 6; ++k) {
-      float& s = acc[size_t(k) * stride + size_t(i)];
-      s += v1 * up[k][i] + v2 * um[k][i];
-    }
+    out.add(i, v1, v2);
   }
 }
 

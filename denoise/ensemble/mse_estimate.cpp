@@ -1,7 +1,10 @@
 #include "denoise/ensemble/mse_estimate.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "denoise/metrics/metrics.h"
 #include "denoise/util/error.h"
@@ -12,6 +15,9 @@ namespace {
 // The consistency test's allowance beyond k·|y^A − y^B|/2, as a fraction of mean |x| + |ȳ|:
 // where the halves agree closely the full run may still differ by its smaller noise.
 constexpr double kConsistencyAllowance = 0.1;
+
+// Rows per task of the image-wide mean of the per-pixel terms.
+constexpr int kPriorBandRows = 32;
 
 bool finite3(const float* v) {
   return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
@@ -83,6 +89,11 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
     throw Error("the MSE outlier cap must be a finite number ≥ 0");
   if (!(options.consistency >= 0) || !std::isfinite(options.consistency))
     throw Error("the consistency tolerance must be a finite number ≥ 0");
+  if (!(options.imagePrior >= 0) || !std::isfinite(options.imagePrior))
+    throw Error("the image prior's weight must be a finite number ≥ 0");
+  if (!(options.plausibility == 0 || options.plausibility >= 1) ||
+      !std::isfinite(options.plausibility))
+    throw Error("the plausibility factor must be 0 (off) or a finite number ≥ 1");
   width_ = guides.width();
   height_ = guides.height();
   baseCount_ = int(bases.size());
@@ -119,6 +130,72 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
     windowGuides_.normal = finitePlanes(guides.normal);
     windowGuides_.albedo = finitePlanes(guides.albedo);
   }
+  if (options.imagePrior > 0 && !reference_) imageMean_ = imageMeanTerms();
+}
+
+std::vector<double> MseEstimator::imageMeanTerms() const {
+  // Bands in parallel, summed in band order (the same result for any thread count).
+  const int bands = (height_ + kPriorBandRows - 1) / kPriorBandRows;
+  std::vector<std::vector<double>> sums(static_cast<size_t>(bands));
+  std::vector<size_t> counts(static_cast<size_t>(bands), 0);
+  tbb::parallel_for(0, bands, [&](int band) {
+    const int y0 = band * kPriorBandRows, y1 = std::min(height_, y0 + kPriorBandRows);
+    std::vector<float> planes;
+    // Relative to μ̂² + (mean |x| / 2)²: every region counts by its relative error, as in
+    // relMSE, but with a knee that follows the image's brightness, not its unit.
+    const std::vector<char> complete = pixelTerms(y0, y1, planes, 0.25 * scale_ * scale_);
+    const size_t pixels = complete.size();
+    std::vector<double>& sum = sums[size_t(band)];
+    sum.assign(size_t(planeCount()), 0.0);
+    for (size_t p = 0; p < pixels; ++p) {
+      if (!complete[p]) continue;
+      ++counts[size_t(band)];
+      for (int k = 0; k < planeCount(); ++k) sum[size_t(k)] += planes[size_t(k) * pixels + p];
+    }
+  });
+  std::vector<double> mean(size_t(planeCount()), 0.0);
+  size_t count = 0;
+  for (int band = 0; band < bands; ++band) {
+    count += counts[size_t(band)];
+    for (int k = 0; k < planeCount(); ++k) mean[size_t(k)] += sums[size_t(band)][size_t(k)];
+  }
+  if (count == 0) return {};
+  for (double& v : mean) v /= double(count);
+  return mean;
+}
+
+void MseEstimator::addImagePrior(MseRows& rows) const {
+  if (imageMean_.empty()) return;
+  const int n = baseCount_, entries = this->entries();
+  const size_t pixels = size_t(rows.y1_ - rows.y0_) * size_t(width_);
+  // The trace on the tangent space {Σv = 0}: tr H − 1ᵀH1/n, the part of H the solve sees.
+  const auto tangentTrace = [&](auto entry) {
+    double trace = 0, total = 0;
+    for (int i = 0, k = 0; i < n; ++i)
+      for (int j = i; j < n; ++j, ++k) {
+        const double v = entry(k);
+        trace += i == j ? v : 0.0;
+        total += i == j ? v : 2.0 * v;
+      }
+    return trace - total / n;
+  };
+  for (int g = 0; g < groups(); ++g) {
+    const double* prior = imageMean_.data() + size_t(g * (entries + 1));
+    const double priorTrace = tangentTrace([&](int k) { return prior[k]; });
+    if (!(priorTrace > 0)) continue;
+    for (size_t p = 0; p < pixels; ++p) {
+      float* h = rows.planes_.data() + size_t(g * (entries + 1)) * pixels + p;
+      const double localTrace = tangentTrace([&](int k) { return double(h[size_t(k) * pixels]); });
+      // No local evidence (no complete pixel in the window): the prior alone.
+      const double factor =
+          localTrace > 0 ? options_.imagePrior * localTrace / priorTrace : 1.0 / priorTrace;
+      for (int k = 0; k < entries; ++k) h[size_t(k) * pixels] += float(factor * prior[k]);
+    }
+  }
+}
+
+double MseEstimator::objectiveEpsilon() const {
+  return options_.relative ? kRelMseEpsilon : -1.0;
 }
 
 BaseMask MseEstimator::validAt(size_t pixel) const {
@@ -135,7 +212,13 @@ BaseMask MseEstimator::validAt(size_t pixel) const {
 
 BaseMask MseEstimator::solvableAt(size_t pixel) const {
   const BaseMask mask = validAt(pixel);
-  if (!(options_.consistency > 0) || reference_) return mask;
+  if (reference_) return mask;
+  BaseMask kept = options_.consistency > 0 ? consistentBases(pixel, mask) : mask;
+  if (kept == 0) kept = mask;
+  return options_.plausibility > 0 ? plausibleBases(pixel, kept) : kept;
+}
+
+BaseMask MseEstimator::consistentBases(size_t pixel, BaseMask mask) const {
   const size_t e = pixel * 3;
   BaseMask consistent = 0;
   for (int i = 0; i < baseCount_; ++i) {
@@ -150,10 +233,42 @@ BaseMask MseEstimator::solvableAt(size_t pixel) const {
     }
     if (close) consistent |= BaseMask(1) << i;
   }
-  return consistent != 0 ? consistent : mask;
+  return consistent;
 }
 
-std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes) const {
+BaseMask MseEstimator::plausibleBases(size_t pixel, BaseMask mask) const {
+  const size_t e = pixel * 3;
+  if (!finite3(colorA_ + e) || !finite3(colorB_ + e)) return mask;
+  // d_i = ½ Σ_c (y_i^A − x^B)² + (y_i^B − x^A)², the pixel's own error term of base i;
+  // allowance = ½ Σ_c (x^A − x^B)² (the halves' noise) + Σ_c (0.1 (mean |x| + |x̄|))².
+  std::array<double, kMaxDenoisers> d{};
+  double least = std::numeric_limits<double>::infinity(), allowance = 0;
+  for (int c = 0; c < 3; ++c) {
+    const double xA = colorA_[e + size_t(c)], xB = colorB_[e + size_t(c)];
+    const double floor = kConsistencyAllowance * (scale_ + 0.5 * std::abs(xA + xB));
+    allowance += 0.5 * (xA - xB) * (xA - xB) + floor * floor;
+  }
+  for (int i = 0; i < baseCount_; ++i) {
+    if (!((mask >> i) & 1u)) continue;
+    for (int c = 0; c < 3; ++c) {
+      const size_t ec = e + size_t(c);
+      const double toB = double(outA_[size_t(i)][ec]) - colorB_[ec];
+      const double toA = double(outB_[size_t(i)][ec]) - colorA_[ec];
+      d[size_t(i)] += 0.5 * (toB * toB + toA * toA);
+    }
+    least = std::min(least, d[size_t(i)]);
+  }
+  // The least d always passes (plausibility ≥ 1), so the result is never empty.
+  const double limit = options_.plausibility * options_.plausibility * (least + allowance);
+  BaseMask plausible = 0;
+  for (int i = 0; i < baseCount_; ++i)
+    if (((mask >> i) & 1u) && d[size_t(i)] <= limit) plausible |= BaseMask(1) << i;
+  return plausible;
+}
+
+std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes,
+                                           double relativeEpsilon) const {
+  const bool relative = relativeEpsilon >= 0;
   const int n = baseCount_, entries = this->entries();
   const size_t pixels = size_t(y1 - y0) * size_t(width_);
   planes.assign(size_t(planeCount()) * pixels, 0.0f);
@@ -171,7 +286,7 @@ std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& p
     for (int c = 0; c < 3; ++c) {
       const size_t ec = e + size_t(c);
       double weight = 1.0 / (scale_ * scale_);
-      if (options_.relative) {
+      if (relative) {
         double mu = 0;
         int count = 0;
         if (reference_) {
@@ -181,7 +296,7 @@ std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& p
             if ((valid >> i) & 1u) mu += outFull_[size_t(i)][ec], ++count;
         }
         mu = count > 0 ? mu / count : 0.0;
-        weight = 1.0 / (mu * mu + kRelMseEpsilon);
+        weight = 1.0 / (mu * mu + relativeEpsilon);
       }
       double* h =
           acc.data() + size_t((options_.form == MseForm::PerChannel ? c : 0) * (entries + 1));
@@ -243,14 +358,15 @@ MseRows MseEstimator::rows(int y0, int y1) const {
 
   const int r = options_.windowRadius;
   if (r == 0) {
-    pixelTerms(y0, y1, out.planes_);
+    pixelTerms(y0, y1, out.planes_, objectiveEpsilon());
+    addImagePrior(out);
     return out;
   }
   // Per-pixel terms of the rows the window reaches; pixels with a non-finite input are left
   // out of every window; then the joint-bilateral window.
   const int inY0 = std::max(0, y0 - r), inY1 = std::min(height_, y1 + r);
   std::vector<float> in;
-  const std::vector<char> complete = pixelTerms(inY0, inY1, in);
+  const std::vector<char> complete = pixelTerms(inY0, inY1, in, objectiveEpsilon());
   const size_t inPixels = size_t(inY1 - inY0) * size_t(width_);
   for (size_t local = 0; local < inPixels; ++local)
     if (!complete[local])
@@ -263,6 +379,7 @@ MseRows MseEstimator::rows(int y0, int y1) const {
     outPlanes.push_back(out.planes_.data() + size_t(k) * pixels);
   }
   filterPlaneRows(windowGuides_, windowKernel_, inPlanes, inY0, y0, y1, outPlanes);
+  addImagePrior(out);
   return out;
 }
 

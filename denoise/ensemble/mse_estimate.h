@@ -38,6 +38,23 @@
 //   a full run that behaves unlike both (NL-means variants that keep a firefly the half runs
 //   removed) is outside what it can see. The pixel still enters its neighbours' windows with
 //   every base. 0 = off.
+// - plausibility κ (0 = off, else ≥ 1): at a pixel, a base whose own error term
+//   d_i = ½ Σ_c (y_i^A − x^B)² + (y_i^B − x^A)² exceeds κ²·(min_j d_j + ½ Σ_c (x^A − x^B)²
+//   + Σ_c (0.1·(mean |x| + |x̄|))²) gets weight 0 there. The window and the outlier cap average a
+//   base's gross error at one pixel (a bright blob that a filter spread from a light, ringing
+//   of a regression next to one) with its neighbours', where it is fine, and the weight filter
+//   spreads the neighbours' weights back onto the pixel; a base that is far from both noisy
+//   halves, by much more than they differ from each other and than the best base is, is not a
+//   denoised estimate there. Applied after the consistency test; as that one, a mask of the
+//   solve only.
+// - imagePrior α (0 = off): add to each pixel's (windowed) H the image-wide mean Ḡ of the
+//   per-pixel terms in relative units (divided by μ̂² + (mean |x|/2)², so that it does not
+//   depend on the unit of radiance), scaled to the same trace on the tangent space {Σv = 0}
+//   (the part of H the solve sees) and times α: H + α·(τ(H)/τ(Ḡ))·Ḡ. Shrinkage towards the
+//   blend that is best over the whole image: a window holds ~100 pixels whose noisy halves, at
+//   a few samples per pixel, cannot rank bases that differ by less than their noise, while the
+//   image-wide mean can; where one base is clearly better locally its H still decides. A pixel
+//   whose window holds no complete pixel gets Ḡ alone. Not applied to the oracle.
 // Non-finite inputs: a base whose output (A, B or full) is NaN/Inf at a pixel is invalid there
 // (its bit in `valid` is 0; the solver gives it weight 0). A pixel where any base or x^A/x^B is
 // non-finite contributes nothing to its neighbours' windows.
@@ -59,6 +76,8 @@ struct MseOptions {
   bool relative = false;
   double outlierCap = 30.0;
   double consistency = 4.0;
+  double plausibility = 4.0;
+  double imagePrior = 0.3;
   float windowSigmaSpatial = 0;  // σ_s in pixels; 0 = the window radius
   float windowSigmaNormal = 0.2f;
   float windowSigmaAlbedo = 0.1f;
@@ -117,7 +136,8 @@ class MseEstimator {
   PixelMse at(int x, int y) const;
   // The bases whose outputs are finite at a pixel (index y·width + x).
   BaseMask validAt(size_t pixel) const;
-  // validAt without the bases that fail the consistency test there: the solver's mask.
+  // validAt without the bases that fail the consistency or plausibility test there: the
+  // solver's mask.
   BaseMask solvableAt(size_t pixel) const;
 
  private:
@@ -125,7 +145,17 @@ class MseEstimator {
                const MseOptions& options, const Image* reference);
   // Per-pixel (unwindowed) planes for rows [y0, y1); returns per pixel whether every base and
   // the noisy halves were finite (only such pixels may enter a neighbour's window).
-  std::vector<char> pixelTerms(int y0, int y1, std::vector<float>& planes) const;
+  // relativeEpsilon < 0: absolute units (divided by scale²); else divided by μ̂² + relativeEpsilon.
+  std::vector<char> pixelTerms(int y0, int y1, std::vector<float>& planes,
+                               double relativeEpsilon) const;
+  double objectiveEpsilon() const;
+  // The mean of the relative per-pixel terms over the complete pixels (empty when none).
+  std::vector<double> imageMeanTerms() const;
+  // H += imagePrior · (tangent trace of H / that of the mean) · mean, per pixel of `rows`.
+  void addImagePrior(MseRows& rows) const;
+  // The bases of `mask` that pass the consistency test / the plausibility test at a pixel.
+  BaseMask consistentBases(size_t pixel, BaseMask mask) const;
+  BaseMask plausibleBases(size_t pixel, BaseMask mask) const;
   int planeCount() const { return groups() * (entries() + 1); }
   int entries() const { return baseCount_ * (baseCount_ + 1) / 2; }
 
@@ -136,6 +166,7 @@ class MseEstimator {
   const float* colorA_ = nullptr;
   const float* colorB_ = nullptr;
   const float* reference_ = nullptr;  // oracle only
+  std::vector<double> imageMean_;     // the image prior's relative terms (empty: none)
   PlanarGuides windowGuides_;
   BilateralKernel windowKernel_;
 };

@@ -30,6 +30,15 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
                  "Give a base weight 0 where its full-buffer output lies more than K times half "
                  "the A/B difference (+10%) from the mean of its half outputs (0 = off)")
       ->capture_default_str();
+  cmd.add_option("--plausibility", plausibility,
+                 "Give a base weight 0 where its own error term exceeds K² times the least base's "
+                 "plus the noisy halves' difference (0 = off, else at least 1)")
+      ->capture_default_str();
+  cmd.add_option("--image-prior", imagePrior,
+                 "Add A times the image-wide mean of the (relative) MSE terms, scaled to each "
+                 "pixel's own, to the pixel's estimate: shrinkage towards the best blend over the "
+                 "image (0 = off)")
+      ->capture_default_str();
   cmd.add_option("--solver-seed", seed, "Seed of the pairwise solver")->capture_default_str();
 }
 
@@ -49,6 +58,11 @@ CombineOptions EnsembleFlags::options() const {
   if (!(consistency >= 0)) throw Error("--consistency must be at least 0");
   o.mse.outlierCap = outlierCap;
   o.mse.consistency = consistency;
+  if (!(plausibility == 0 || plausibility >= 1))
+    throw Error("--plausibility must be 0 (off) or at least 1");
+  o.mse.plausibility = plausibility;
+  if (!(imagePrior >= 0)) throw Error("--image-prior must be at least 0");
+  o.mse.imagePrior = imagePrior;
   if (weightFilter != "bilateral" && weightFilter != "none")
     throw Error("unknown --weight-filter '" + weightFilter + "' (known: bilateral, none)");
   o.filter.enabled = weightFilter == "bilateral";

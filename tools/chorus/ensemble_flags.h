@@ -15,6 +15,8 @@ struct EnsembleFlags {
   bool relative = MseOptions{}.relative;
   double outlierCap = MseOptions{}.outlierCap;
   double consistency = MseOptions{}.consistency;
+  double plausibility = MseOptions{}.plausibility;
+  double imagePrior = MseOptions{}.imagePrior;
   uint64_t seed = 1;
 
   bool weightFilterGiven = false;  // --weight-filter was on the command line

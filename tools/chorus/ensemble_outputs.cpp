@@ -51,6 +51,8 @@ nlohmann::ordered_json combineOptionsJson(const CombineOptions& o) {
           {"relative", o.mse.relative},
           {"outlier_cap", o.mse.outlierCap},
           {"consistency", o.mse.consistency},
+          {"plausibility", o.mse.plausibility},
+          {"image_prior", o.mse.imagePrior},
           {"weight_filter", o.filter.enabled ? "bilateral" : "none"},
           {"solver_seed", o.seed}};
 }

@@ -221,6 +221,8 @@ TEST(RenderCli, PreviewWritesOnlyThePngAndStats) {
   EXPECT_EQ(stats["spp"], 4);
   EXPECT_EQ(stats["denoise"]["methods"], json({"atrous", "atrous:iterations=4:sigmaL=8:sigmaN=16"}));
   EXPECT_EQ(stats["denoise"]["weight_filter"], "none");
+  EXPECT_EQ(stats["denoise"]["image_prior"], 0.0);
+  EXPECT_EQ(stats["denoise"]["plausibility"], 4.0);
 }
 
 TEST(InfoCli, SummarisesTheScene) {

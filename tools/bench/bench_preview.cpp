@@ -18,12 +18,12 @@
 #include "denoise/ensemble/ensemble.h"
 #include "denoise/image/png_io.h"
 #include "denoise/metrics/metrics.h"
+#include "denoise/util/memory_reuse.h"
 #include "denoise/util/stopwatch.h"
 #include "renderer/render.h"
 #include "renderer/scene/gltf_loader.h"
 #include "tools/chorus/render_denoise.h"
 #include "tools/sweep/reference_render.h"
-#include "denoise/util/memory_reuse.h"
 
 namespace {
 
@@ -96,6 +96,7 @@ int main(int argc, char** argv) {
   options.threads = threads;
   CombineOptions previewOptions;
   previewOptions.filter.enabled = false;  // as `chorus render --preview`
+  previewOptions.mse.imagePrior = 0;
   const Ensemble ensemble(membersFromSpecs(splitMethodList(preview)), previewOptions);
   options.splits = splitsNeeded(ensemble.members());  // as `chorus render`
 

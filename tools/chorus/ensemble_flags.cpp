@@ -37,8 +37,9 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
   cmd.add_option("--image-prior", imagePrior,
                  "Add A times the image-wide mean of the (relative) MSE terms, scaled to each "
                  "pixel's own, to the pixel's estimate: shrinkage towards the best blend over the "
-                 "image (0 = off)")
-      ->capture_default_str();
+                 "image (0 = off; previews: 0 unless given)")
+      ->capture_default_str()
+      ->each([this](const std::string&) { imagePriorGiven = true; });
   cmd.add_option("--solver-seed", seed, "Seed of the pairwise solver")->capture_default_str();
 }
 

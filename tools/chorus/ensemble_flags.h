@@ -20,6 +20,7 @@ struct EnsembleFlags {
   uint64_t seed = 1;
 
   bool weightFilterGiven = false;  // --weight-filter was on the command line
+  bool imagePriorGiven = false;    // --image-prior was on the command line
 
   void addFlags(CLI::App& cmd);
   // Throws chorus::Error for an unknown value.

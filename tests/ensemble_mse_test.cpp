@@ -336,6 +336,19 @@ TEST(MseEstimate, NonFiniteOutputsAreExcluded) {
   }
 }
 
+// With a mask test on (`on`) and off (`off`), the solver's mask is `mask` at (x0, y0) and all
+// three bases elsewhere, and the estimate itself (which the neighbours' windows use) is the same.
+void expectOnlyMaskChanges(const Fixture& f, const MseOptions& on, const MseOptions& off, int x0,
+                           int y0, BaseMask mask) {
+  const MseEstimator with(f.guides, pointers(f), on), without(f.guides, pointers(f), off);
+  for (int y = 0; y < f.truth.height(); ++y)
+    for (int x = 0; x < f.truth.width(); ++x) {
+      EXPECT_EQ(with.at(x, y).valid, x == x0 && y == y0 ? mask : 0b111u) << x << "," << y;
+      EXPECT_EQ(without.at(x, y).valid, 0b111u) << x << "," << y;
+      EXPECT_EQ(with.at(x, y).h[0], without.at(x, y).h[0]) << x << "," << y;
+    }
+}
+
 // A base whose full-buffer output strays from both of its half outputs (a firefly kept only in
 // the full run) is left out of the solve at that pixel, and only there; the estimate itself,
 // which the neighbours' windows use, is the same with and without the test.
@@ -346,14 +359,7 @@ TEST(MseEstimate, InconsistentFullRunIsLeftOutOfTheSolve) {
   MseOptions on, off;
   on.windowRadius = off.windowRadius = 2;
   off.consistency = 0;
-  const MseEstimator with(f.guides, pointers(f), on), without(f.guides, pointers(f), off);
-  for (int y = 0; y < 10; ++y)
-    for (int x = 0; x < 12; ++x) {
-      const bool stray = x == 4 && y == 4;
-      EXPECT_EQ(with.at(x, y).valid, stray ? 0b101u : 0b111u) << x << "," << y;
-      EXPECT_EQ(without.at(x, y).valid, 0b111u) << x << "," << y;
-      EXPECT_EQ(with.at(x, y).h[0], without.at(x, y).h[0]) << x << "," << y;
-    }
+  expectOnlyMaskChanges(f, on, off, 4, 4, 0b101u);
   // When every base strays the test would leave nothing: all of them stay.
   for (BaseOutputs& b : f.bases) b.full(4, 4, 0) += 20.0f;
   EXPECT_EQ(MseEstimator(f.guides, pointers(f), on).at(4, 4).valid, 0b111u);
@@ -369,13 +375,7 @@ TEST(MseEstimate, ImplausibleBaseIsLeftOutOfTheSolve) {
   MseOptions on, off;
   on.windowRadius = off.windowRadius = 2;
   off.plausibility = 0;
-  const MseEstimator with(f.guides, pointers(f), on), without(f.guides, pointers(f), off);
-  for (int y = 0; y < 10; ++y)
-    for (int x = 0; x < 12; ++x) {
-      EXPECT_EQ(with.at(x, y).valid, x == 4 && y == 4 ? 0b101u : 0b111u) << x << "," << y;
-      EXPECT_EQ(without.at(x, y).valid, 0b111u) << x << "," << y;
-      EXPECT_EQ(with.at(x, y).h[0], without.at(x, y).h[0]) << x << "," << y;
-    }
+  expectOnlyMaskChanges(f, on, off, 4, 4, 0b101u);
 
   // At (8, 6) put base 2 at a distance t from the other half in every channel of both halves
   // (d_2 = 3t²), just inside and just outside the limit computed here from the definition.

@@ -44,6 +44,15 @@ std::vector<uint8_t> finiteMask(std::initializer_list<const Image*> images) {
   return mask;
 }
 
+Image meanOf(const Image& a, const Image& b) {
+  requireSameShape(a, b, "meanOf");
+  Image out(a.width(), a.height(), a.channels());
+  parallelChunks(a.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) out.data()[i] = 0.5f * (a.data()[i] + b.data()[i]);
+  });
+  return out;
+}
+
 Image squaredDifference(const Image& a, const Image& b, float scale) {
   requireSameShape(a, b, "squaredDifference");
   Image out(a.width(), a.height(), a.channels());

@@ -28,6 +28,9 @@ inline float finiteOrZero(float v) {
 // Per pixel: 1 where every channel of every listed image is finite, else 0.
 std::vector<uint8_t> finiteMask(std::initializer_list<const Image*> images);
 
+// (a + b) / 2 per channel: the mean of two buffers of equal sample counts (elements in parallel).
+Image meanOf(const Image& a, const Image& b);
+
 // (a − b)² · scale per channel, 0 where a or b is not finite. With scale 1/4 this is an unbiased
 // estimate of the variance of the mean of (a + b) / 2, with 1/2 of the variance of each buffer's
 // mean (equal sample counts, independent samples; §0).

@@ -109,9 +109,7 @@ Image runJointNlMeans(const DenoiseInput& input, const JointNlMeansParams& param
     const Image varianceB = halfVarianceOfMean(input, 1, Quantity::Color);
     const Image filteredA = filter(a, b, varianceB);  // A's data, B's colour weights
     const Image filteredB = filter(b, a, varianceA);
-    out = Image(a.width(), a.height(), 3);
-    for (size_t k = 0; k < out.size(); ++k)
-      out.data()[k] = 0.5f * (filteredA.data()[k] + filteredB.data()[k]);
+    out = meanOf(filteredA, filteredB);
   } else {
     const Image color = finiteOr(whole.color.mean, 0.0f);
     const Image variance =

@@ -18,14 +18,6 @@ void requireRange(bool ok, const std::string& what) {
   if (!ok) throw Error("rdfc: " + what);
 }
 
-Image average(const Image& a, const Image& b) {
-  Image out(a.width(), a.height(), a.channels());
-  parallelChunks(out.size(), [&](size_t begin, size_t end) {
-    for (size_t k = begin; k < end; ++k) out.data()[k] = 0.5f * (a.data()[k] + b.data()[k]);
-  });
-  return out;
-}
-
 // Colour-guided NL-means without features (RDFC's selection smoothing): patch radius f, k,
 // weights boxed over boxRadius, window r.
 std::vector<Image> colorNlMeans(std::span<const Image* const> data, const Image& guide,
@@ -99,7 +91,7 @@ Image blendCandidates(const RdfcResult& result, Image RdfcCandidate::*buffer) {
 // Step 5: the second pass on the first-pass buffers.
 Image secondPass(const Image& first1, const Image& first2, const std::vector<RdfcFeature>& features,
                  const RdfcParams& params) {
-  const Image guide = average(first1, first2);
+  const Image guide = meanOf(first1, first2);
   const Image variance = smooth3Tap(squaredDifference(first1, first2, 0.25f), std::exp(-2.0f));
   const PatchTerm patch{.guide = &guide,
                         .variance = &variance,
@@ -121,7 +113,7 @@ Image secondPass(const Image& first1, const Image& first2, const std::vector<Rdf
   const Image* data[] = {&first1, &first2};
   const std::vector<Image> filtered = featureNlMeans(
       data, &patch, featureTerms, {.r = params.secondR, .minCenterWeight = kMinCenterWeight});
-  return average(filtered[0], filtered[1]);
+  return meanOf(filtered[0], filtered[1]);
 }
 
 }  // namespace
@@ -181,11 +173,11 @@ RdfcResult runRdfc(const DenoiseInput& input, const RdfcParams& params) {
   result.candidates = rdfcCandidates(b1, b2, result.colorVariance, features, params.candidates);
 
   // 4. Selection and first-pass output.
-  const Image guide = average(b1, b2);
+  const Image guide = meanOf(b1, b2);
   selectCandidates(guide, result.colorVariance, params, result);
   const Image first1 = blendCandidates(result, &RdfcCandidate::buffer1);
   const Image first2 = blendCandidates(result, &RdfcCandidate::buffer2);
-  result.firstPass = average(first1, first2);
+  result.firstPass = meanOf(first1, first2);
 
   // 5. Second pass.
   result.output = secondPass(first1, first2, features, params);

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "denoise/base/bordered_planes.h"
+#include "denoise/base/buffer_variance.h"
 #include "denoise/base/filters/pixel_rect.h"
 #include "denoise/base/nlmeans_row_kernels.h"
 #include "denoise/base/rect_mask.h"
@@ -43,8 +44,8 @@ struct TileMemory {
   std::vector<float> innerSums, invY, running;   // the narrower patch's sums, 1 / y counts
   std::vector<float> dist[kColor][3], invCountStore[kColor][3];
   std::vector<float> fullInvCountX[kColor], fullInvCount[kColor];  // boxes inside the image
-  const float* invCount[kColor][3] = {};  // 1 / box counts of this offset
-  std::vector<float> slope[3][3], nearSlope[3][3];  // [channel][kind]
+  const float* invCount[kColor][3] = {};                           // 1 / box counts of this offset
+  std::vector<float> slope[3][3], nearSlope[3][3];                 // [channel][kind]
   // Accumulators, per candidate: Σw, max w, Σ w b1 (3 planes), Σ w b2 (3 planes); per colour
   // candidate and channel of y(p): Σ ∂w, Σ ∂w y(q), ∂(max w).
   std::vector<float> weightSum[3], maxWeight[3], acc[3];
@@ -98,10 +99,7 @@ CandidateKernel::CandidateKernel(const Image& b1, const Image& b2, const Image& 
     throw std::invalid_argument("rdfcCandidates: bad radius");
   grow_ = std::max(params.fFirst, params.fSecond);
   pad_ = 2 * params.r + grow_ + 1;
-  guide_ = Image(width_, height_, 3);
-  parallelChunks(guide_.size(), [&](size_t begin, size_t end) {
-    for (size_t k = begin; k < end; ++k) guide_.data()[k] = 0.5f * (b1.data()[k] + b2.data()[k]);
-  });
+  guide_ = meanOf(b1, b2);
   for (BorderedPlanes* p : {&b1_, &b2_, &g_, &vn_, &vd_})
     *p = BorderedPlanes(width_, height_, 3, pad_);
   for (int c = 0; c < 3; ++c) {
@@ -249,8 +247,8 @@ void CandidateKernel::colorDistances(const PixelRect& tile, int dx, int dy, Tile
     }
     // The 7-row boxes slide down the tile; 3 rows are summed directly (as cheap).
     if (2 * f + 1 > 3) {
-      rows::runningBoxMeans(tw, th, sums, stride, 2 * f + 1, m.invY.data(), invX,
-                            m.running.data(), m.dist[s][kind].data(), size_t(tw));
+      rows::runningBoxMeans(tw, th, sums, stride, 2 * f + 1, m.invY.data(), invX, m.running.data(),
+                            m.dist[s][kind].data(), size_t(tw));
       return;
     }
     for (int y = tile.y0; y < tile.y1; ++y)

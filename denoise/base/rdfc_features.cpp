@@ -56,8 +56,7 @@ RdfcFeature prefilter(const std::string& name, const MappedFeature& whole,
 
   // Guide: the mean of the buffers with the (rescaled) variance of that mean; unknown pixels get
   // a NaN variance, so they match nothing and are not mixed into their neighbours.
-  Image guide(f1.width(), f1.height(), channels);
-  for (size_t k = 0; k < guide.size(); ++k) guide.data()[k] = 0.5f * (f1.data()[k] + f2.data()[k]);
+  const Image guide = meanOf(f1, f2);
   const Image twoBuffer = squaredDifference(f1, f2, 0.25f);
   const Image sample = completedVariance(whole.variance, twoBuffer);
   Image variance =
@@ -78,9 +77,7 @@ RdfcFeature prefilter(const std::string& name, const MappedFeature& whole,
   const Image& g1 = filtered[0];
   const Image& g2 = filtered[1];
 
-  feature.value = Image(f1.width(), f1.height(), channels);
-  for (size_t k = 0; k < g1.size(); ++k)
-    feature.value.data()[k] = 0.5f * (g1.data()[k] + g2.data()[k]);
+  feature.value = meanOf(g1, g2);
   feature.variance = smooth3Tap(squaredDifference(g1, g2, 0.25f), std::exp(-2.0f), &known);
   feature.gradient = squaredGradient(feature.value, &known);
   for (size_t i = 0; i < known.size(); ++i) {

@@ -95,8 +95,7 @@ int main(int argc, char** argv) {
   options.spp = spp;
   options.threads = threads;
   CombineOptions previewOptions;
-  previewOptions.filter.enabled = false;  // as `chorus render --preview`
-  previewOptions.mse.imagePrior = 0;
+  cli::applyPreviewDefaults(previewOptions, false, false);  // as `chorus render --preview`
   const Ensemble ensemble(membersFromSpecs(splitMethodList(preview)), previewOptions);
   options.splits = splitsNeeded(ensemble.members());  // as `chorus render`
 

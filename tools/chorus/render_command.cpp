@@ -42,11 +42,8 @@ struct RenderArgs {
 DenoiseStage denoiseStageOf(const RenderArgs& args) {
   CombineOptions options = args.ensemble.options();
   options.combiner = parseCombiner(args.combine);
-  if (args.preview && !args.ensemble.weightFilterGiven) options.filter.enabled = false;
-  // Previews skip the image prior too: their two à-trous members differ by detail, not by a
-  // ranking the whole image agrees on (cornell-box 512², 4 spp: relMSE 0.00505 without, 0.00511
-  // with, and a pass over the image less).
-  if (args.preview && !args.ensemble.imagePriorGiven) options.mse.imagePrior = 0;
+  if (args.preview)
+    applyPreviewDefaults(options, args.ensemble.weightFilterGiven, args.ensemble.imagePriorGiven);
   const std::string list = args.denoiseGiven ? args.denoise : args.preview ? "preview" : "default";
   DenoiseStage stage = DenoiseStage::parse(list, options, !args.preview);
   const int needed = stage.splitsNeeded();

@@ -19,6 +19,20 @@ constexpr double kConsistencyAllowance = 0.1;
 // Rows per task of the image-wide mean of the per-pixel terms.
 constexpr int kPriorBandRows = 32;
 
+// The trace of a packed symmetric n × n matrix on the tangent space {Σv = 0}: tr H − 1ᵀH1/n,
+// the part of H the solve sees. entry(k) = the k-th packed entry.
+template <typename Entry>
+double tangentTrace(int n, const Entry& entry) {
+  double trace = 0, total = 0;
+  for (int i = 0, k = 0; i < n; ++i)
+    for (int j = i; j < n; ++j, ++k) {
+      const double v = entry(k);
+      trace += i == j ? v : 0.0;
+      total += i == j ? v : 2.0 * v;
+    }
+  return trace - total / n;
+}
+
 bool finite3(const float* v) {
   return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
 }
@@ -130,10 +144,10 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
     windowGuides_.normal = finitePlanes(guides.normal);
     windowGuides_.albedo = finitePlanes(guides.albedo);
   }
-  if (options.imagePrior > 0 && !reference_) imageMean_ = imageMeanTerms();
+  if (options.imagePrior > 0 && !reference_) imagePrior_ = imagePriorTerms();
 }
 
-std::vector<double> MseEstimator::imageMeanTerms() const {
+std::vector<double> MseEstimator::imagePriorTerms() const {
   // Bands in parallel, summed in band order (the same result for any thread count).
   const int bands = (height_ + kPriorBandRows - 1) / kPriorBandRows;
   std::vector<std::vector<double>> sums(static_cast<size_t>(bands));
@@ -160,35 +174,27 @@ std::vector<double> MseEstimator::imageMeanTerms() const {
     for (int k = 0; k < planeCount(); ++k) mean[size_t(k)] += sums[size_t(band)][size_t(k)];
   }
   if (count == 0) return {};
-  for (double& v : mean) v /= double(count);
+  // Per group, divided by its tangent trace (a group without one adds nothing).
+  const int n = baseCount_, entries = this->entries();
+  for (int g = 0; g < groups(); ++g) {
+    double* group = mean.data() + size_t(g * (entries + 1));
+    const double trace = tangentTrace(n, [&](int k) { return group[k]; });
+    for (int k = 0; k < entries; ++k) group[k] = trace > 0 ? group[k] / trace : 0.0;
+  }
   return mean;
 }
 
 void MseEstimator::addImagePrior(MseRows& rows) const {
-  if (imageMean_.empty()) return;
+  if (imagePrior_.empty()) return;
   const int n = baseCount_, entries = this->entries();
   const size_t pixels = size_t(rows.y1_ - rows.y0_) * size_t(width_);
-  // The trace on the tangent space {Σv = 0}: tr H − 1ᵀH1/n, the part of H the solve sees.
-  const auto tangentTrace = [&](auto entry) {
-    double trace = 0, total = 0;
-    for (int i = 0, k = 0; i < n; ++i)
-      for (int j = i; j < n; ++j, ++k) {
-        const double v = entry(k);
-        trace += i == j ? v : 0.0;
-        total += i == j ? v : 2.0 * v;
-      }
-    return trace - total / n;
-  };
   for (int g = 0; g < groups(); ++g) {
-    const double* prior = imageMean_.data() + size_t(g * (entries + 1));
-    const double priorTrace = tangentTrace([&](int k) { return prior[k]; });
-    if (!(priorTrace > 0)) continue;
+    const double* prior = imagePrior_.data() + size_t(g * (entries + 1));
     for (size_t p = 0; p < pixels; ++p) {
       float* h = rows.planes_.data() + size_t(g * (entries + 1)) * pixels + p;
-      const double localTrace = tangentTrace([&](int k) { return double(h[size_t(k) * pixels]); });
+      const double local = tangentTrace(n, [&](int k) { return double(h[size_t(k) * pixels]); });
       // No local evidence (no complete pixel in the window): the prior alone.
-      const double factor =
-          localTrace > 0 ? options_.imagePrior * localTrace / priorTrace : 1.0 / priorTrace;
+      const double factor = local > 0 ? options_.imagePrior * local : 1.0;
       for (int k = 0; k < entries; ++k) h[size_t(k) * pixels] += float(factor * prior[k]);
     }
   }

@@ -149,9 +149,10 @@ class MseEstimator {
   std::vector<char> pixelTerms(int y0, int y1, std::vector<float>& planes,
                                double relativeEpsilon) const;
   double objectiveEpsilon() const;
-  // The mean of the relative per-pixel terms over the complete pixels (empty when none).
-  std::vector<double> imageMeanTerms() const;
-  // H += imagePrior · (tangent trace of H / that of the mean) · mean, per pixel of `rows`.
+  // The mean of the relative per-pixel terms over the complete pixels, per group divided by its
+  // tangent trace (empty when no pixel is complete).
+  std::vector<double> imagePriorTerms() const;
+  // H += imagePrior · (tangent trace of H) · imagePrior_, per pixel of `rows`.
   void addImagePrior(MseRows& rows) const;
   // The bases of `mask` that pass the consistency test / the plausibility test at a pixel.
   BaseMask consistentBases(size_t pixel, BaseMask mask) const;
@@ -166,7 +167,7 @@ class MseEstimator {
   const float* colorA_ = nullptr;
   const float* colorB_ = nullptr;
   const float* reference_ = nullptr;  // oracle only
-  std::vector<double> imageMean_;     // the image prior's relative terms (empty: none)
+  std::vector<double> imagePrior_;    // imagePriorTerms() (empty: no prior)
   PlanarGuides windowGuides_;
   BilateralKernel windowKernel_;
 };

@@ -412,6 +412,49 @@ TEST(MseEstimate, ImplausibleBaseIsLeftOutOfTheSolve) {
   EXPECT_THROW(MseEstimator(f.guides, pointers(f), on), Error);
 }
 
+// Where half A holds a firefly, every base's B term (y^B − x^A)² is huge and hides, in the
+// whole-pixel test, the base that passed the firefly through its A run; each half's own test
+// (at 2κ, against the other half as comparator) leaves it out, at that pixel only.
+TEST(MseEstimate, FireflyHalfRevealsTheBaseThatPassedItThrough) {
+  Fixture f = makeFixture(12, 10, 9);
+  for (int c = 0; c < 3; ++c) {
+    f.guides.colorA(4, 4, c) += 40.0f;
+    f.bases[1].a(4, 4, c) = f.guides.colorA(4, 4, c);
+    f.bases[1].full(4, 4, c) = 0.5f * (f.bases[1].a(4, 4, c) + f.bases[1].b(4, 4, c));
+  }
+  MseOptions on, off;
+  on.windowRadius = off.windowRadius = 2;
+  off.plausibility = 0;
+  expectOnlyMaskChanges(f, on, off, 4, 4, 0b101u);
+
+  // At (8, 6), with a firefly in half A, put base 2's A run at a distance t from x^B in every
+  // channel (tA_2 = 3t²), just inside and just outside (2κ)²·(least other tA + 10 % floor of x^B).
+  const int x = 8, y = 6;
+  for (int c = 0; c < 3; ++c) f.guides.colorA(x, y, c) += 40.0f;
+  double scale = 0;
+  for (const Image* image : {&f.guides.colorA, &f.guides.colorB})
+    for (float v : image->values()) scale += std::abs(v) / double(2 * image->size());
+  auto termA = [&](int i) {
+    double t = 0;
+    for (int c = 0; c < 3; ++c)
+      t += std::pow(f.bases[size_t(i)].a(x, y, c) - f.guides.colorB(x, y, c), 2);
+    return t;
+  };
+  double floorB = 0;
+  for (int c = 0; c < 3; ++c) floorB += std::pow(0.1 * (scale + std::abs(f.guides.colorB(x, y, c))), 2);
+  const double limit = 64.0 * (std::min(termA(0), termA(1)) + floorB);
+  for (double share : {0.99, 1.01}) {
+    const double t = std::sqrt(share * limit / 3.0);
+    for (int c = 0; c < 3; ++c) {
+      f.bases[2].a(x, y, c) = float(f.guides.colorB(x, y, c) + t);
+      f.bases[2].full(x, y, c) = 0.5f * (f.bases[2].a(x, y, c) + f.bases[2].b(x, y, c));
+    }
+    ASSERT_NEAR(termA(2), share * limit, 1e-4 * limit);
+    EXPECT_EQ(MseEstimator(f.guides, pointers(f), on).at(x, y).valid, share < 1 ? 0b111u : 0b011u)
+        << share;
+  }
+}
+
 // With the image prior, each pixel's H gains α·(τ(H)/τ(Ḡ))·Ḡ: Ḡ the mean over the image of the
 // per-pixel terms divided by μ̂² + (mean |x| / 2)², τ the trace on the tangent space {Σv = 0}.
 TEST(MseEstimate, ImagePriorAddsTheScaledImageMean) {

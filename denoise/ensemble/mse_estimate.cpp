@@ -245,31 +245,45 @@ BaseMask MseEstimator::consistentBases(size_t pixel, BaseMask mask) const {
 BaseMask MseEstimator::plausibleBases(size_t pixel, BaseMask mask) const {
   const size_t e = pixel * 3;
   if (!finite3(colorA_ + e) || !finite3(colorB_ + e)) return mask;
-  // d_i = ½ Σ_c (y_i^A − x^B)² + (y_i^B − x^A)², the pixel's own error term of base i;
-  // allowance = ½ Σ_c (x^A − x^B)² (the halves' noise) + Σ_c (0.1 (mean |x| + |x̄|))².
-  std::array<double, kMaxDenoisers> d{};
-  double least = std::numeric_limits<double>::infinity(), allowance = 0;
+  // Per base, the two halves' own error terms tA_i = Σ_c (y_i^A − x^B)², tB_i = Σ_c (y_i^B − x^A)²
+  // and their mean d_i; floors Σ_c (0.1 (mean |x| + |x|))² of x^A, x^B and their mean.
+  std::array<double, kMaxDenoisers> tA{}, tB{};
+  double floorA = 0, floorB = 0, floorMean = 0, halvesApart = 0;
   for (int c = 0; c < 3; ++c) {
     const double xA = colorA_[e + size_t(c)], xB = colorB_[e + size_t(c)];
-    const double floor = kConsistencyAllowance * (scale_ + 0.5 * std::abs(xA + xB));
-    allowance += 0.5 * (xA - xB) * (xA - xB) + floor * floor;
+    const double fA = kConsistencyAllowance * (scale_ + std::abs(xA));
+    const double fB = kConsistencyAllowance * (scale_ + std::abs(xB));
+    const double fMean = kConsistencyAllowance * (scale_ + 0.5 * std::abs(xA + xB));
+    floorA += fA * fA, floorB += fB * fB, floorMean += fMean * fMean;
+    halvesApart += 0.5 * (xA - xB) * (xA - xB);
   }
+  const double inf = std::numeric_limits<double>::infinity();
+  double leastA = inf, leastB = inf, least = inf;
   for (int i = 0; i < baseCount_; ++i) {
     if (!((mask >> i) & 1u)) continue;
     for (int c = 0; c < 3; ++c) {
       const size_t ec = e + size_t(c);
       const double toB = double(outA_[size_t(i)][ec]) - colorB_[ec];
       const double toA = double(outB_[size_t(i)][ec]) - colorA_[ec];
-      d[size_t(i)] += 0.5 * (toB * toB + toA * toA);
+      tA[size_t(i)] += toB * toB, tB[size_t(i)] += toA * toA;
     }
-    least = std::min(least, d[size_t(i)]);
+    leastA = std::min(leastA, tA[size_t(i)]), leastB = std::min(leastB, tB[size_t(i)]);
+    least = std::min(least, 0.5 * (tA[size_t(i)] + tB[size_t(i)]));
   }
-  // The least d always passes (plausibility ≥ 1), so the result is never empty.
-  const double limit = options_.plausibility * options_.plausibility * (least + allowance);
-  BaseMask plausible = 0;
-  for (int i = 0; i < baseCount_; ++i)
-    if (((mask >> i) & 1u) && d[size_t(i)] <= limit) plausible |= BaseMask(1) << i;
-  return plausible;
+  // The whole-pixel test; the least d always passes (κ ≥ 1), so it never empties the mask.
+  const double k2 = options_.plausibility * options_.plausibility;
+  const double limit = k2 * (least + halvesApart + floorMean);
+  // Each half's test, at 2κ: the term of a half whose comparator is a firefly is useless, and
+  // its size in the mean d hides the other half's evidence.
+  const double limitA = 4.0 * k2 * (leastA + floorB), limitB = 4.0 * k2 * (leastB + floorA);
+  BaseMask plausible = 0, inBothHalves = 0;
+  for (int i = 0; i < baseCount_; ++i) {
+    if (!((mask >> i) & 1u) || 0.5 * (tA[size_t(i)] + tB[size_t(i)]) > limit) continue;
+    plausible |= BaseMask(1) << i;
+    if (tA[size_t(i)] <= limitA && tB[size_t(i)] <= limitB) inBothHalves |= BaseMask(1) << i;
+  }
+  // The half tests may together reject every base (each half's best fails the other's test).
+  return inBothHalves != 0 ? inBothHalves : plausible;
 }
 
 std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes,

@@ -45,8 +45,13 @@
 //   of a regression next to one) with its neighbours', where it is fine, and the weight filter
 //   spreads the neighbours' weights back onto the pixel; a base that is far from both noisy
 //   halves, by much more than they differ from each other and than the best base is, is not a
-//   denoised estimate there. Applied after the consistency test; as that one, a mask of the
-//   solve only.
+//   denoised estimate there. Each half is also tested on its own, at 2κ: a base whose
+//   tA_i = Σ_c (y_i^A − x^B)² exceeds (2κ)²·(min_j tA_j + Σ_c (0.1·(mean |x| + |x^B|))²), or
+//   likewise tB_i = Σ_c (y_i^B − x^A)², gets weight 0 too (unless that leaves no base). Where
+//   one half holds a firefly, its term is large for every base and swamps d_i, while the other
+//   half's term still shows which bases passed the firefly through (NFOR and NL-means variants
+//   on 4 spp, README). Applied after the consistency test; as that one, a mask of the solve
+//   only.
 // - imagePrior α (0 = off): add to each pixel's (windowed) H the image-wide mean Ḡ of the
 //   per-pixel terms in relative units (divided by μ̂² + (mean |x|/2)², so that it does not
 //   depend on the unit of radiance), scaled to the same trace on the tangent space {Σv = 0}

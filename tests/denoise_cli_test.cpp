@@ -68,7 +68,10 @@ TEST(DenoiseCli, OutputsDirectoryWithReference) {
     EXPECT_TRUE(fs::is_regular_file(out / name)) << name;
   EXPECT_EQ(layerNames(out / "ensemble.exr"),
             (std::vector<std::string>{"", "A", "B", "mseEstimate"}));
-  EXPECT_EQ(layerNames(out / "weights.exr"), (std::vector<std::string>{"box1", "guided", "nlm"}));
+  EXPECT_EQ(layerNames(out / "weights.exr"),
+            (std::vector<std::string>{"box1", "guided", "nlm", "noisyFallback"}));
+  EXPECT_EQ(layerNames(out / "weights-average.exr"),
+            (std::vector<std::string>{"box1", "guided", "nlm"}));  // the ensemble's only
   EXPECT_EQ(layerNames(out / "box1.exr"), (std::vector<std::string>{"", "A", "B"}));
 
   // The file is what the library computes with the same (default) options.

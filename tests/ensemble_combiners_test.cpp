@@ -88,6 +88,38 @@ TEST(EnsembleCombiners, ConsistentWhenOneBaseIsExact) {
   EXPECT_LT(errors.back(), 1e-7);
 }
 
+// Where every base puts a bright blob that neither noisy half shows, the ensemble's result is
+// the noisy value (and the half blends the noisy halves); everywhere else the result is the
+// blend, bit for bit the same as with the fallback off.
+TEST(EnsembleCombiners, NoisyFallbackWhereNoBaseIsPlausible) {
+  synthetic::Case c = synthetic::standardCases()[0];
+  synthetic::PreparedCase p = synthetic::prepareCase(c, 24, 20);
+  const int x = 7, y = 9;
+  for (BaseOutputs& b : p.bases)
+    for (Image* image : {&b.a, &b.b, &b.full})
+      for (int ch = 0; ch < 3; ++ch) (*image)(x, y, ch) += 50.0f;
+  const CombineResult on = combine(p.guides, pointersTo(p.bases), {});
+  CombineOptions offOptions;
+  offOptions.mse.noisyFallback = 0;
+  const CombineResult off = combine(p.guides, pointersTo(p.bases), offOptions);
+  EXPECT_EQ(on.noisyFallbackPixels, 1u);
+  EXPECT_EQ(off.noisyFallbackPixels, 0u);
+  for (int py = 0; py < 20; ++py)
+    for (int px = 0; px < 24; ++px) {
+      const bool here = px == x && py == y;
+      EXPECT_EQ(on.noisyFallback(px, py, 0), here ? 1.0f : 0.0f);
+      for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_EQ(on.image(px, py, ch), here ? p.guides.color(px, py, ch) : off.image(px, py, ch));
+        EXPECT_EQ(on.imageA(px, py, ch), here ? p.guides.colorA(px, py, ch) : off.imageA(px, py, ch));
+      }
+    }
+  EXPECT_GT(off.image(x, y, 0), p.guides.color(x, y, 0) + 10.0f);  // the blend kept the blob
+  // Only the ensemble falls back: the other combiners are the paper's definitions.
+  CombineOptions average;
+  average.combiner = Combiner::Average;
+  EXPECT_TRUE(combine(p.guides, pointersTo(p.bases), average).noisyFallback.empty());
+}
+
 // A small prepared case for the robustness tests.
 synthetic::PreparedCase smallCase(uint64_t seed = 3) {
   synthetic::Case c = synthetic::standardCases()[0];

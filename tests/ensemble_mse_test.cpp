@@ -455,6 +455,48 @@ TEST(MseEstimate, FireflyHalfRevealsTheBaseThatPassedItThrough) {
   }
 }
 
+// Where even the best base is far from both noisy halves (its own term d above K² times the
+// halves' difference plus a 10 % floor), the pixel is flagged for the noisy fallback; the limit
+// is computed here from the definition and checked just inside and just outside.
+TEST(MseEstimate, NoBasePlausibleWhereEveryBaseIsFarFromBothHalves) {
+  Fixture f = makeFixture(12, 10, 10);
+  const MseOptions defaults;
+  const int x = 5, y = 3, width = 12;
+  {
+    const MseEstimator estimator(f.guides, pointers(f), defaults);
+    for (size_t p = 0; p < size_t(12 * 10); ++p) EXPECT_FALSE(estimator.noBasePlausible(p)) << p;
+  }
+  double scale = 0;
+  for (const Image* image : {&f.guides.colorA, &f.guides.colorB})
+    for (float v : image->values()) scale += std::abs(v) / double(2 * image->size());
+  double allowance = 0;
+  for (int c = 0; c < 3; ++c) {
+    const double xA = f.guides.colorA(x, y, c), xB = f.guides.colorB(x, y, c);
+    allowance += 0.5 * (xA - xB) * (xA - xB) + std::pow(0.1 * (scale + std::abs(xA + xB) / 2), 2);
+  }
+  const double limit = 100.0 * allowance;  // K = 10
+  for (double share : {0.99, 1.01}) {
+    // Base i at a distance (1 + i)·t from the other half in every channel of both halves:
+    // the least d is base 0's, 3t².
+    const double t = std::sqrt(share * limit / 3.0);
+    for (int i = 0; i < 3; ++i)
+      for (int c = 0; c < 3; ++c) {
+        BaseOutputs& b = f.bases[size_t(i)];
+        b.a(x, y, c) = float(f.guides.colorB(x, y, c) + (1 + i) * t);
+        b.b(x, y, c) = float(f.guides.colorA(x, y, c) + (1 + i) * t);
+        b.full(x, y, c) = 0.5f * (b.a(x, y, c) + b.b(x, y, c));
+      }
+    const MseEstimator estimator(f.guides, pointers(f), defaults);
+    EXPECT_EQ(estimator.noBasePlausible(size_t(y * width + x)), share > 1) << share;
+    MseOptions off;
+    off.noisyFallback = 0;
+    EXPECT_FALSE(MseEstimator(f.guides, pointers(f), off).noBasePlausible(size_t(y * width + x)));
+  }
+  MseOptions bad;
+  bad.noisyFallback = 0.5;
+  EXPECT_THROW(MseEstimator(f.guides, pointers(f), bad), Error);
+}
+
 // With the image prior, each pixel's H gains α·(τ(H)/τ(Ḡ))·Ḡ: Ḡ the mean over the image of the
 // per-pixel terms divided by μ̂² + (mean |x| / 2)², τ the trace on the tangent space {Σv = 0}.
 TEST(MseEstimate, ImagePriorAddsTheScaledImageMean) {

@@ -186,9 +186,10 @@ TEST(RenderCli, DenoisesInProcessLikeChorusDenoiseOnTheWrittenRender) {
   EXPECT_TRUE(std::equal(inProcess.values().begin(), inProcess.values().end(),
                          fromFile.values().begin()));
   const std::vector<ExrLayer> weights = readExr(out / "weights.exr");
-  ASSERT_EQ(weights.size(), 2u);
+  ASSERT_EQ(weights.size(), 3u);
   EXPECT_EQ(weights[0].name, "atrous");
   EXPECT_EQ(weights[1].name, "jnlm");
+  EXPECT_EQ(weights[2].name, "noisyFallback");  // 1 where the result is the noisy value
   for (int y = 0; y < weights[0].image.height(); ++y)
     for (int x = 0; x < weights[0].image.width(); ++x)
       EXPECT_NEAR(weights[0].image.at(x, y, 0) + weights[1].image.at(x, y, 0), 1.0, 1e-5);
@@ -200,6 +201,9 @@ TEST(RenderCli, DenoisesInProcessLikeChorusDenoiseOnTheWrittenRender) {
                             "write denoised", "total"})
     EXPECT_GE(stats["seconds"][stage].get<double>(), 0.0) << stage;
   EXPECT_EQ(stats["denoise"]["methods"], json({"atrous", "jnlm"}));
+  size_t fallbackPixels = 0;
+  for (float v : weights[2].image.values()) fallbackPixels += v == 1.0f;
+  EXPECT_EQ(stats["denoise"]["noisy_fallback_pixels"].get<size_t>(), fallbackPixels);
   const json& m = stats["metrics"];
   EXPECT_LT(m["denoised"]["relmse"].get<double>(), 0.5 * m["noisy"]["relmse"].get<double>());
   EXPECT_LT(m["atrous"]["relmse"].get<double>(), m["noisy"]["relmse"].get<double>());

@@ -243,6 +243,14 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
       SolvedWeights solved = solveWeights(estimator, options.solver, options.qp, options.seed);
       result.rawWeights = std::move(solved.weights);
       valid = std::move(solved.valid);
+      result.noisyFallback = Image(w, h, 1);
+      tbb::parallel_for(0, h, [&](int y) {
+        for (int x = 0; x < w; ++x)
+          if (estimator.noBasePlausible(size_t(y) * size_t(w) + size_t(x)) &&
+              std::isfinite(guides.color(x, y, 0)) && std::isfinite(guides.color(x, y, 1)) &&
+              std::isfinite(guides.color(x, y, 2)))
+            result.noisyFallback(x, y, 0) = 1.0f;
+      });
       break;
     }
     case Combiner::Oracle:
@@ -318,6 +326,17 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
   }
 
   Blends blends = blendAll(result.weights, bases, guides);
+  if (!result.noisyFallback.empty())
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (result.noisyFallback(x, y, 0) == 0.0f) continue;
+        ++result.noisyFallbackPixels;
+        for (int c = 0; c < 3; ++c) {
+          blends.full(x, y, c) = guides.color(x, y, c);
+          blends.a(x, y, c) = guides.colorA(x, y, c);
+          blends.b(x, y, c) = guides.colorB(x, y, c);
+        }
+      }
   result.image = std::move(blends.full);
   result.mseEstimate = estimatedBlendMse(blends.a, blends.b, guides.colorA, guides.colorB);
   result.imageA = std::move(blends.a);

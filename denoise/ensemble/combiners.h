@@ -60,6 +60,9 @@ struct CombineResult {
                                   // form) or 1 (summed form)
   std::vector<Image> rawWeights;  // the weights before the weight filter
   Image mseEstimate;              // estimatedBlendMse of the result (RGB)
+  Image noisyFallback;            // 1 where the ensemble's result is the noisy value
+                                  // (MseOptions::noisyFallback), else 0 (1 channel)
+  size_t noisyFallbackPixels = 0;
   std::vector<StageTime> times;   // "solve", "filter", "blend"
 };
 

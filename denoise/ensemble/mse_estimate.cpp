@@ -108,6 +108,9 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
   if (!(options.plausibility == 0 || options.plausibility >= 1) ||
       !std::isfinite(options.plausibility))
     throw Error("the plausibility factor must be 0 (off) or a finite number ≥ 1");
+  if (!(options.noisyFallback == 0 || options.noisyFallback >= 1) ||
+      !std::isfinite(options.noisyFallback))
+    throw Error("the noisy fallback's factor must be 0 (off) or a finite number ≥ 1");
   width_ = guides.width();
   height_ = guides.height();
   baseCount_ = int(bases.size());
@@ -242,48 +245,60 @@ BaseMask MseEstimator::consistentBases(size_t pixel, BaseMask mask) const {
   return consistent;
 }
 
-BaseMask MseEstimator::plausibleBases(size_t pixel, BaseMask mask) const {
+MseEstimator::HalfTerms MseEstimator::halfTermsAt(size_t pixel, BaseMask mask) const {
   const size_t e = pixel * 3;
-  if (!finite3(colorA_ + e) || !finite3(colorB_ + e)) return mask;
-  // Per base, the two halves' own error terms tA_i = Σ_c (y_i^A − x^B)², tB_i = Σ_c (y_i^B − x^A)²
-  // and their mean d_i; floors Σ_c (0.1 (mean |x| + |x|))² of x^A, x^B and their mean.
-  std::array<double, kMaxDenoisers> tA{}, tB{};
-  double floorA = 0, floorB = 0, floorMean = 0, halvesApart = 0;
+  HalfTerms t;
   for (int c = 0; c < 3; ++c) {
     const double xA = colorA_[e + size_t(c)], xB = colorB_[e + size_t(c)];
     const double fA = kConsistencyAllowance * (scale_ + std::abs(xA));
     const double fB = kConsistencyAllowance * (scale_ + std::abs(xB));
     const double fMean = kConsistencyAllowance * (scale_ + 0.5 * std::abs(xA + xB));
-    floorA += fA * fA, floorB += fB * fB, floorMean += fMean * fMean;
-    halvesApart += 0.5 * (xA - xB) * (xA - xB);
+    t.floorA += fA * fA, t.floorB += fB * fB, t.floorMean += fMean * fMean;
+    t.halvesApart += 0.5 * (xA - xB) * (xA - xB);
   }
-  const double inf = std::numeric_limits<double>::infinity();
-  double leastA = inf, leastB = inf, least = inf;
   for (int i = 0; i < baseCount_; ++i) {
     if (!((mask >> i) & 1u)) continue;
     for (int c = 0; c < 3; ++c) {
       const size_t ec = e + size_t(c);
       const double toB = double(outA_[size_t(i)][ec]) - colorB_[ec];
       const double toA = double(outB_[size_t(i)][ec]) - colorA_[ec];
-      tA[size_t(i)] += toB * toB, tB[size_t(i)] += toA * toA;
+      t.a[size_t(i)] += toB * toB, t.b[size_t(i)] += toA * toA;
     }
-    leastA = std::min(leastA, tA[size_t(i)]), leastB = std::min(leastB, tB[size_t(i)]);
-    least = std::min(least, 0.5 * (tA[size_t(i)] + tB[size_t(i)]));
+    t.leastA = std::min(t.leastA, t.a[size_t(i)]), t.leastB = std::min(t.leastB, t.b[size_t(i)]);
+    t.least = std::min(t.least, t.mean(i));
   }
+  return t;
+}
+
+BaseMask MseEstimator::plausibleBases(size_t pixel, BaseMask mask) const {
+  const size_t e = pixel * 3;
+  if (!finite3(colorA_ + e) || !finite3(colorB_ + e)) return mask;
+  const HalfTerms t = halfTermsAt(pixel, mask);
   // The whole-pixel test; the least d always passes (κ ≥ 1), so it never empties the mask.
   const double k2 = options_.plausibility * options_.plausibility;
-  const double limit = k2 * (least + halvesApart + floorMean);
+  const double limit = k2 * (t.least + t.halvesApart + t.floorMean);
   // Each half's test, at 2κ: the term of a half whose comparator is a firefly is useless, and
   // its size in the mean d hides the other half's evidence.
-  const double limitA = 4.0 * k2 * (leastA + floorB), limitB = 4.0 * k2 * (leastB + floorA);
+  const double limitA = 4.0 * k2 * (t.leastA + t.floorB);
+  const double limitB = 4.0 * k2 * (t.leastB + t.floorA);
   BaseMask plausible = 0, inBothHalves = 0;
   for (int i = 0; i < baseCount_; ++i) {
-    if (!((mask >> i) & 1u) || 0.5 * (tA[size_t(i)] + tB[size_t(i)]) > limit) continue;
+    if (!((mask >> i) & 1u) || t.mean(i) > limit) continue;
     plausible |= BaseMask(1) << i;
-    if (tA[size_t(i)] <= limitA && tB[size_t(i)] <= limitB) inBothHalves |= BaseMask(1) << i;
+    if (t.a[size_t(i)] <= limitA && t.b[size_t(i)] <= limitB) inBothHalves |= BaseMask(1) << i;
   }
   // The half tests may together reject every base (each half's best fails the other's test).
   return inBothHalves != 0 ? inBothHalves : plausible;
+}
+
+bool MseEstimator::noBasePlausible(size_t pixel) const {
+  const size_t e = pixel * 3;
+  const BaseMask mask = validAt(pixel);
+  if (options_.noisyFallback == 0 || reference_ || mask == 0 || !finite3(colorA_ + e) ||
+      !finite3(colorB_ + e))
+    return false;
+  const HalfTerms t = halfTermsAt(pixel, mask);
+  return t.least > options_.noisyFallback * options_.noisyFallback * (t.halvesApart + t.floorMean);
 }
 
 std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes,

@@ -60,10 +60,17 @@
 //   a few samples per pixel, cannot rank bases that differ by less than their noise, while the
 //   image-wide mean can; where one base is clearly better locally its H still decides. A pixel
 //   whose window holds no complete pixel gets Ḡ alone. Not applied to the oracle.
+// - noisyFallback K (0 = off, else ≥ 1; applied by the ensemble combiner): where even the best
+//   base's d_i exceeds K²·(½ Σ_c (x^A − x^B)² + Σ_c (0.1·(mean |x| + |x̄|))²), the result is the
+//   noisy full-buffer value. Every base then spread energy into the pixel that neither half
+//   shows (a lamp's bulb smeared onto the black pixel beside it: LightsPunctualLamp, 128 spp,
+//   rdfc 22 and sbf 3.5 where the reference is 0.03 and all four sub-buffers 0.0001), and no
+//   blend of them can be right; the pixel's own samples can.
 // Non-finite inputs: a base whose output (A, B or full) is NaN/Inf at a pixel is invalid there
 // (its bit in `valid` is 0; the solver gives it weight 0). A pixel where any base or x^A/x^B is
 // non-finite contributes nothing to its neighbours' windows.
 #include <array>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -83,6 +90,7 @@ struct MseOptions {
   double consistency = 4.0;
   double plausibility = 4.0;
   double imagePrior = 0.3;
+  double noisyFallback = 10.0;
   float windowSigmaSpatial = 0;  // σ_s in pixels; 0 = the window radius
   float windowSigmaNormal = 0.2f;
   float windowSigmaAlbedo = 0.1f;
@@ -144,6 +152,10 @@ class MseEstimator {
   // validAt without the bases that fail the consistency or plausibility test there: the
   // solver's mask.
   BaseMask solvableAt(size_t pixel) const;
+  // True where noisyFallback K is on and even the best finite base's own error term d exceeds
+  // K²·(½ Σ_c (x^A − x^B)² + Σ_c (0.1·(mean |x| + |x̄|))²): every base is far from both noisy
+  // halves, which agree (see noisyFallback).
+  bool noBasePlausible(size_t pixel) const;
 
  private:
   MseEstimator(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,
@@ -159,6 +171,16 @@ class MseEstimator {
   std::vector<double> imagePriorTerms() const;
   // H += imagePrior · (tangent trace of H) · imagePrior_, per pixel of `rows`.
   void addImagePrior(MseRows& rows) const;
+  // Per base of a mask at a pixel: each half's own error term, tA_i = Σ_c (y_i^A − x^B)² and
+  // tB_i = Σ_c (y_i^B − x^A)², their least values and the allowances the tests compare with.
+  struct HalfTerms {
+    std::array<double, kMaxDenoisers> a{}, b{};
+    double leastA = std::numeric_limits<double>::infinity(), leastB = leastA, least = leastA;
+    double floorA = 0, floorB = 0, floorMean = 0;  // Σ_c (0.1 (mean |x| + |x|))² of x^A, x^B, x̄
+    double halvesApart = 0;                        // ½ Σ_c (x^A − x^B)²
+    double mean(int i) const { return 0.5 * (a[size_t(i)] + b[size_t(i)]); }  // d_i
+  };
+  HalfTerms halfTermsAt(size_t pixel, BaseMask mask) const;
   // The bases of `mask` that pass the consistency test / the plausibility test at a pixel.
   BaseMask consistentBases(size_t pixel, BaseMask mask) const;
   BaseMask plausibleBases(size_t pixel, BaseMask mask) const;

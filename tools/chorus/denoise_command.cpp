@@ -138,6 +138,8 @@ void runDenoise(const DenoiseArgs& args) {
                   k == 0 ? "weights.exr" : "weights-" + name + ".exr");
     times[name + "/write"] = write.seconds();
     if (reference) metrics[name] = metricsJson(result.image, *reference);
+    if (o.combiner == Combiner::Ensemble)
+      stats["noisy_fallback_pixels"] = result.noisyFallbackPixels;
     std::cout << "wrote " << (out / (name + ".exr")).string() << "\n";
   }
   const Stopwatch writeBases;

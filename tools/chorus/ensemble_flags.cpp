@@ -40,6 +40,11 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
                  "image (0 = off; previews: 0 unless given)")
       ->capture_default_str()
       ->each([this](const std::string&) { imagePriorGiven = true; });
+  cmd.add_option("--noisy-fallback", noisyFallback,
+                 "Use the noisy value where even the best base's own error term exceeds K² times "
+                 "the noisy halves' difference (+10%): every base is far from both halves "
+                 "(0 = off, else at least 1)")
+      ->capture_default_str();
   cmd.add_option("--solver-seed", seed, "Seed of the pairwise solver")->capture_default_str();
 }
 
@@ -64,6 +69,9 @@ CombineOptions EnsembleFlags::options() const {
   o.mse.plausibility = plausibility;
   if (!(imagePrior >= 0)) throw Error("--image-prior must be at least 0");
   o.mse.imagePrior = imagePrior;
+  if (!(noisyFallback == 0 || noisyFallback >= 1))
+    throw Error("--noisy-fallback must be 0 (off) or at least 1");
+  o.mse.noisyFallback = noisyFallback;
   if (weightFilter != "bilateral" && weightFilter != "none")
     throw Error("unknown --weight-filter '" + weightFilter + "' (known: bilateral, none)");
   o.filter.enabled = weightFilter == "bilateral";

@@ -17,6 +17,7 @@ struct EnsembleFlags {
   double consistency = MseOptions{}.consistency;
   double plausibility = MseOptions{}.plausibility;
   double imagePrior = MseOptions{}.imagePrior;
+  double noisyFallback = MseOptions{}.noisyFallback;
   uint64_t seed = 1;
 
   bool weightFilterGiven = false;  // --weight-filter was on the command line

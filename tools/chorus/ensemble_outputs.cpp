@@ -53,6 +53,7 @@ nlohmann::ordered_json combineOptionsJson(const CombineOptions& o) {
           {"consistency", o.mse.consistency},
           {"plausibility", o.mse.plausibility},
           {"image_prior", o.mse.imagePrior},
+          {"noisy_fallback", o.mse.noisyFallback},
           {"weight_filter", o.filter.enabled ? "bilateral" : "none"},
           {"solver_seed", o.seed}};
 }
@@ -67,6 +68,7 @@ void writeCombined(const std::filesystem::path& dir, const std::string& name,
   writePng(dir / (name + ".png"), result.image);
   std::vector<ExrLayer> weights;
   for (size_t i = 0; i < bases.size(); ++i) weights.push_back({bases[i].name, result.weights[i]});
+  if (!result.noisyFallback.empty()) weights.push_back({"noisyFallback", result.noisyFallback});
   writeExr(dir / weightsFile, weights);
 }
 

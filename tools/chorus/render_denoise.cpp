@@ -46,6 +46,7 @@ double DenoiseStage::run(const EnsembleSources& sources, const std::filesystem::
 
   stats["denoise"] = combineOptionsJson(options);
   stats["denoise"]["methods"] = specs;
+  stats["denoise"]["noisy_fallback_pixels"] = result.combined.noisyFallbackPixels;
   if (reference) {
     nlohmann::ordered_json& metrics = stats["metrics"];
     metrics["noisy"] = metricsJson(result.guides.color, *reference);

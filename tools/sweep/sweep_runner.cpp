@@ -92,7 +92,8 @@ std::string sweepSettings(const SweepConfig& config) {
        << (c.mse.form == MseForm::Summed ? "summed" : "per-channel") << " window "
        << c.mse.windowRadius << (c.mse.relative ? " relative" : " absolute") << " outlier-cap "
        << c.mse.outlierCap << " consistency " << c.mse.consistency << " plausibility "
-       << c.mse.plausibility << " image-prior " << c.mse.imagePrior << " filter "
+       << c.mse.plausibility << " image-prior " << c.mse.imagePrior << " noisy-fallback "
+       << c.mse.noisyFallback << " filter "
        << (c.filter.enabled ? "bilateral" : "none") << " seed " << c.seed << "\ncrop "
        << config.cropSize << "\n";
   return text.str();

@@ -336,6 +336,14 @@ TEST(MseEstimate, NonFiniteOutputsAreExcluded) {
   }
 }
 
+// mean |x| over both noisy halves: the scale of the 10 % floors.
+double meanAbsOfHalves(const Fixture& f) {
+  double scale = 0;
+  for (const Image* image : {&f.guides.colorA, &f.guides.colorB})
+    for (float v : image->values()) scale += std::abs(v) / double(2 * image->size());
+  return scale;
+}
+
 // With a mask test on (`on`) and off (`off`), the solver's mask is `mask` at (x0, y0) and all
 // three bases elsewhere, and the estimate itself (which the neighbours' windows use) is the same.
 void expectOnlyMaskChanges(const Fixture& f, const MseOptions& on, const MseOptions& off, int x0,
@@ -380,9 +388,7 @@ TEST(MseEstimate, ImplausibleBaseIsLeftOutOfTheSolve) {
   // At (8, 6) put base 2 at a distance t from the other half in every channel of both halves
   // (d_2 = 3t²), just inside and just outside the limit computed here from the definition.
   const int x = 8, y = 6;
-  double scale = 0;
-  for (const Image* image : {&f.guides.colorA, &f.guides.colorB})
-    for (float v : image->values()) scale += std::abs(v) / double(2 * image->size());
+  const double scale = meanAbsOfHalves(f);
   auto term = [&](int i) {
     double d = 0;
     for (int c = 0; c < 3; ++c)
@@ -431,9 +437,7 @@ TEST(MseEstimate, FireflyHalfRevealsTheBaseThatPassedItThrough) {
   // channel (tA_2 = 3t²), just inside and just outside (2κ)²·(least other tA + 10 % floor of x^B).
   const int x = 8, y = 6;
   for (int c = 0; c < 3; ++c) f.guides.colorA(x, y, c) += 40.0f;
-  double scale = 0;
-  for (const Image* image : {&f.guides.colorA, &f.guides.colorB})
-    for (float v : image->values()) scale += std::abs(v) / double(2 * image->size());
+  const double scale = meanAbsOfHalves(f);
   auto termA = [&](int i) {
     double t = 0;
     for (int c = 0; c < 3; ++c)
@@ -466,9 +470,7 @@ TEST(MseEstimate, NoBasePlausibleWhereEveryBaseIsFarFromBothHalves) {
     const MseEstimator estimator(f.guides, pointers(f), defaults);
     for (size_t p = 0; p < size_t(12 * 10); ++p) EXPECT_FALSE(estimator.noBasePlausible(p)) << p;
   }
-  double scale = 0;
-  for (const Image* image : {&f.guides.colorA, &f.guides.colorB})
-    for (float v : image->values()) scale += std::abs(v) / double(2 * image->size());
+  const double scale = meanAbsOfHalves(f);
   double allowance = 0;
   for (int c = 0; c < 3; ++c) {
     const double xA = f.guides.colorA(x, y, c), xB = f.guides.colorB(x, y, c);
@@ -502,9 +504,7 @@ TEST(MseEstimate, NoBasePlausibleWhereEveryBaseIsFarFromBothHalves) {
 TEST(MseEstimate, ImagePriorAddsTheScaledImageMean) {
   const Fixture f = makeFixture(14, 11, 8);
   const int n = 3, w = 14, h = 11;
-  double scale = 0;
-  for (const Image* image : {&f.guides.colorA, &f.guides.colorB})
-    for (float v : image->values()) scale += std::abs(v) / double(2 * image->size());
+  const double scale = meanAbsOfHalves(f);
   MseMatrix mean = MseMatrix::Zero(n, n);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)

@@ -102,9 +102,11 @@ TEST(DenoiseCli, OptionsReachTheLibrary) {
   const fs::path out = f.dir / "out";
   const auto r = runChorus({"denoise", f.input.string(), "--methods", "box1,nlm", "--mse",
                             "per-channel", "--window", "0", "--weight-filter", "none", "--solver",
-                            "pairwise", "--solver-seed", "5", "--relative", "--out", out.string()});
+                            "pairwise", "--solver-seed", "5", "--relative", "--noisy-fallback",
+                            "1.5", "--out", out.string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   CombineOptions o;
+  o.mse.noisyFallback = 1.5;
   o.mse.form = MseForm::PerChannel;
   o.mse.windowRadius = 0;
   o.mse.relative = true;
@@ -117,6 +119,9 @@ TEST(DenoiseCli, OptionsReachTheLibrary) {
   EXPECT_TRUE(
       std::equal(written.values().begin(), written.values().end(), direct.image.values().begin()));
   EXPECT_EQ(readExrLayer(out / "weights.exr", "box1").channels(), 3);  // per channel
+  const json stats = readJson(out / "stats.json");
+  EXPECT_EQ(stats["options"]["noisy_fallback"], 1.5);
+  EXPECT_EQ(stats["noisy_fallback_pixels"].get<size_t>(), direct.noisyFallbackPixels);
 }
 
 TEST(DenoiseCli, CleanFailures) {
@@ -138,6 +143,8 @@ TEST(DenoiseCli, CleanFailures) {
                 "needs --reference");
   expectOneLine({in, "--methods", "box1", "--mse", "diagonal", "--out", out.string()},
                 "unknown --mse");
+  expectOneLine({in, "--methods", "box1", "--noisy-fallback", "0.5", "--out", out.string()},
+                "--noisy-fallback must be 0 (off) or at least 1");
   expectOneLine({(f.dir / "nothing").string(), "--methods", "box1", "--out", out.string()},
                 "no such file or directory");
   // A method file of another size.

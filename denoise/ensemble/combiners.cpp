@@ -37,6 +37,7 @@ std::vector<Image> zeroMaps(int n, int width, int height, int channels) {
 struct SolvedWeights {
   std::vector<Image> weights;
   std::vector<BaseMask> valid;
+  std::vector<char> noisyFallback;  // MseRows::noisyFallback per pixel
 };
 
 // Rows per task of the solve: ⟨M⟩ is computed band by band (bounded memory, the window's halo
@@ -49,7 +50,8 @@ SolvedWeights solveWeights(const MseEstimator& estimator, SolverKind solver,
                            const SimplexQpOptions& qp, uint64_t seed) {
   const int n = estimator.baseCount(), groups = estimator.groups();
   const int w = estimator.width(), h = estimator.height();
-  SolvedWeights solved{zeroMaps(n, w, h, groups), std::vector<BaseMask>(size_t(w) * size_t(h))};
+  SolvedWeights solved{zeroMaps(n, w, h, groups), std::vector<BaseMask>(size_t(w) * size_t(h)),
+                       std::vector<char>(size_t(w) * size_t(h))};
   const int bands = (h + kBandRows - 1) / kBandRows;
   tbb::parallel_for(0, bands, [&](int band) {
     const MseRows rows = estimator.rows(band * kBandRows, (band + 1) * kBandRows);
@@ -64,6 +66,7 @@ SolvedWeights solveWeights(const MseEstimator& estimator, SolverKind solver,
         rows.pixel(x, y, pixel);
         const size_t p = size_t(y) * size_t(w) + size_t(x);
         solved.valid[p] = pixel.valid;
+        solved.noisyFallback[p] = rows.noisyFallback(x, y);
         for (int g = 0; g < groups; ++g) {
           WeightVector weights;
           if (solver == SolverKind::ActiveSet) {
@@ -244,13 +247,12 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
       result.rawWeights = std::move(solved.weights);
       valid = std::move(solved.valid);
       result.noisyFallback = Image(w, h, 1);
-      tbb::parallel_for(0, h, [&](int y) {
+      for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
-          if (estimator.noBasePlausible(size_t(y) * size_t(w) + size_t(x)) &&
+          if (solved.noisyFallback[size_t(y) * size_t(w) + size_t(x)] &&
               std::isfinite(guides.color(x, y, 0)) && std::isfinite(guides.color(x, y, 1)) &&
               std::isfinite(guides.color(x, y, 2)))
             result.noisyFallback(x, y, 0) = 1.0f;
-      });
       break;
     }
     case Combiner::Oracle:

@@ -219,12 +219,28 @@ BaseMask MseEstimator::validAt(size_t pixel) const {
   return mask;
 }
 
-BaseMask MseEstimator::solvableAt(size_t pixel) const {
-  const BaseMask mask = validAt(pixel);
-  if (reference_) return mask;
-  BaseMask kept = options_.consistency > 0 ? consistentBases(pixel, mask) : mask;
-  if (kept == 0) kept = mask;
-  return options_.plausibility > 0 ? plausibleBases(pixel, kept) : kept;
+BaseMask MseEstimator::solvableAt(size_t pixel) const { return masksAt(pixel).solvable; }
+
+bool MseEstimator::noBasePlausible(size_t pixel) const { return masksAt(pixel).noisyFallback; }
+
+MseEstimator::PixelMasks MseEstimator::masksAt(size_t pixel) const {
+  const BaseMask valid = validAt(pixel);
+  PixelMasks masks{valid, false};
+  if (reference_) return masks;
+  BaseMask kept = options_.consistency > 0 ? consistentBases(pixel, valid) : valid;
+  if (kept == 0) kept = valid;
+  masks.solvable = kept;
+  const size_t e = pixel * 3;
+  if (!(options_.plausibility > 0 || options_.noisyFallback > 0) || valid == 0 ||
+      !finite3(colorA_ + e) || !finite3(colorB_ + e))
+    return masks;
+  const HalfTerms terms = halfTermsAt(pixel, valid);
+  if (options_.plausibility > 0) masks.solvable = plausibleBases(kept, terms);
+  const double k2 = options_.noisyFallback * options_.noisyFallback;
+  masks.noisyFallback = options_.noisyFallback > 0 &&
+                        terms.least(valid, baseCount_).mean >
+                            k2 * (terms.halvesApart + terms.floorMean);
+  return masks;
 }
 
 BaseMask MseEstimator::consistentBases(size_t pixel, BaseMask mask) const {
@@ -264,23 +280,29 @@ MseEstimator::HalfTerms MseEstimator::halfTermsAt(size_t pixel, BaseMask mask) c
       const double toA = double(outB_[size_t(i)][ec]) - colorA_[ec];
       t.a[size_t(i)] += toB * toB, t.b[size_t(i)] += toA * toA;
     }
-    t.leastA = std::min(t.leastA, t.a[size_t(i)]), t.leastB = std::min(t.leastB, t.b[size_t(i)]);
-    t.least = std::min(t.least, t.mean(i));
   }
   return t;
 }
 
-BaseMask MseEstimator::plausibleBases(size_t pixel, BaseMask mask) const {
-  const size_t e = pixel * 3;
-  if (!finite3(colorA_ + e) || !finite3(colorB_ + e)) return mask;
-  const HalfTerms t = halfTermsAt(pixel, mask);
+MseEstimator::HalfTerms::Least MseEstimator::HalfTerms::least(BaseMask mask, int baseCount) const {
+  const double inf = std::numeric_limits<double>::infinity();
+  Least l{inf, inf, inf};
+  for (int i = 0; i < baseCount; ++i)
+    if ((mask >> i) & 1u)
+      l.a = std::min(l.a, a[size_t(i)]), l.b = std::min(l.b, b[size_t(i)]),
+      l.mean = std::min(l.mean, mean(i));
+  return l;
+}
+
+BaseMask MseEstimator::plausibleBases(BaseMask mask, const HalfTerms& t) const {
+  const HalfTerms::Least least = t.least(mask, baseCount_);
   // The whole-pixel test; the least d always passes (κ ≥ 1), so it never empties the mask.
   const double k2 = options_.plausibility * options_.plausibility;
-  const double limit = k2 * (t.least + t.halvesApart + t.floorMean);
+  const double limit = k2 * (least.mean + t.halvesApart + t.floorMean);
   // Each half's test, at 2κ: the term of a half whose comparator is a firefly is useless, and
   // its size in the mean d hides the other half's evidence.
-  const double limitA = 4.0 * k2 * (t.leastA + t.floorB);
-  const double limitB = 4.0 * k2 * (t.leastB + t.floorA);
+  const double limitA = 4.0 * k2 * (least.a + t.floorB);
+  const double limitB = 4.0 * k2 * (least.b + t.floorA);
   BaseMask plausible = 0, inBothHalves = 0;
   for (int i = 0; i < baseCount_; ++i) {
     if (!((mask >> i) & 1u) || t.mean(i) > limit) continue;
@@ -289,16 +311,6 @@ BaseMask MseEstimator::plausibleBases(size_t pixel, BaseMask mask) const {
   }
   // The half tests may together reject every base (each half's best fails the other's test).
   return inBothHalves != 0 ? inBothHalves : plausible;
-}
-
-bool MseEstimator::noBasePlausible(size_t pixel) const {
-  const size_t e = pixel * 3;
-  const BaseMask mask = validAt(pixel);
-  if (options_.noisyFallback == 0 || reference_ || mask == 0 || !finite3(colorA_ + e) ||
-      !finite3(colorB_ + e))
-    return false;
-  const HalfTerms t = halfTermsAt(pixel, mask);
-  return t.least > options_.noisyFallback * options_.noisyFallback * (t.halvesApart + t.floorMean);
 }
 
 std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes,
@@ -388,8 +400,12 @@ MseRows MseEstimator::rows(int y0, int y1) const {
   out.unit_ = options_.relative ? 1.0 : scale_ * scale_;
   const size_t pixels = size_t(y1 - y0) * size_t(width_);
   out.valid_.resize(pixels);
-  for (size_t local = 0; local < pixels; ++local)
-    out.valid_[local] = solvableAt(size_t(y0) * size_t(width_) + local);
+  out.fallback_.resize(pixels);
+  for (size_t local = 0; local < pixels; ++local) {
+    const PixelMasks masks = masksAt(size_t(y0) * size_t(width_) + local);
+    out.valid_[local] = masks.solvable;
+    out.fallback_[local] = masks.noisyFallback;
+  }
 
   const int r = options_.windowRadius;
   if (r == 0) {

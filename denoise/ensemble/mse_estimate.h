@@ -114,6 +114,8 @@ class MseRows {
   // Only the diagonal of h (the per-base estimated MSE), for the one-hot combiners.
   double diagonal(int x, int y, int group, int base) const;
   BaseMask valid(int x, int y) const { return valid_[index(x, y)]; }
+  // MseEstimator::noBasePlausible at the pixel.
+  bool noisyFallback(int x, int y) const { return fallback_[index(x, y)] != 0; }
 
  private:
   friend class MseEstimator;
@@ -122,6 +124,7 @@ class MseRows {
   double unit_ = 1.0;          // stored value × unit = objective units
   std::vector<float> planes_;  // plane (g·(entries + 1) + e), e = packed upper triangle, then c
   std::vector<BaseMask> valid_;
+  std::vector<char> fallback_;
 };
 
 // Computes ⟨M⟩ for a fixed set of inputs. Holds pointers to the images it was built from (they
@@ -172,18 +175,27 @@ class MseEstimator {
   // H += imagePrior · (tangent trace of H) · imagePrior_, per pixel of `rows`.
   void addImagePrior(MseRows& rows) const;
   // Per base of a mask at a pixel: each half's own error term, tA_i = Σ_c (y_i^A − x^B)² and
-  // tB_i = Σ_c (y_i^B − x^A)², their least values and the allowances the tests compare with.
+  // tB_i = Σ_c (y_i^B − x^A)², and the allowances the tests compare them with.
   struct HalfTerms {
     std::array<double, kMaxDenoisers> a{}, b{};
-    double leastA = std::numeric_limits<double>::infinity(), leastB = leastA, least = leastA;
     double floorA = 0, floorB = 0, floorMean = 0;  // Σ_c (0.1 (mean |x| + |x|))² of x^A, x^B, x̄
     double halvesApart = 0;                        // ½ Σ_c (x^A − x^B)²
     double mean(int i) const { return 0.5 * (a[size_t(i)] + b[size_t(i)]); }  // d_i
+    struct Least {
+      double a, b, mean;
+    };
+    Least least(BaseMask mask, int baseCount) const;  // least tA, tB and d over `mask`
   };
   HalfTerms halfTermsAt(size_t pixel, BaseMask mask) const;
+  // The solver's mask and the fallback flag at a pixel, from one evaluation of the half terms.
+  struct PixelMasks {
+    BaseMask solvable = 0;
+    bool noisyFallback = false;
+  };
+  PixelMasks masksAt(size_t pixel) const;
   // The bases of `mask` that pass the consistency test / the plausibility test at a pixel.
   BaseMask consistentBases(size_t pixel, BaseMask mask) const;
-  BaseMask plausibleBases(size_t pixel, BaseMask mask) const;
+  BaseMask plausibleBases(BaseMask mask, const HalfTerms& terms) const;
   int planeCount() const { return groups() * (entries() + 1); }
   int entries() const { return baseCount_ * (baseCount_ + 1) / 2; }
 

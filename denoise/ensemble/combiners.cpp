@@ -237,6 +237,7 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
   StageClock clock(result.times);
 
   std::vector<BaseMask> valid;
+  std::vector<char> fallback;  // ensemble only: the noisy value replaces the blend there
   bool nonNegative = true, filter = options.filter.enabled;
   // onehot-pre filters the MSE maps, not the weights, and times its own stages.
   const bool filtersBeforeChoosing = options.combiner == Combiner::OnehotPre;
@@ -246,13 +247,7 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
       SolvedWeights solved = solveWeights(estimator, options.solver, options.qp, options.seed);
       result.rawWeights = std::move(solved.weights);
       valid = std::move(solved.valid);
-      result.noisyFallback = Image(w, h, 1);
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
-          if (solved.noisyFallback[size_t(y) * size_t(w) + size_t(x)] &&
-              std::isfinite(guides.color(x, y, 0)) && std::isfinite(guides.color(x, y, 1)) &&
-              std::isfinite(guides.color(x, y, 2)))
-            result.noisyFallback(x, y, 0) = 1.0f;
+      fallback = std::move(solved.noisyFallback);
       break;
     }
     case Combiner::Oracle:
@@ -328,10 +323,14 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
   }
 
   Blends blends = blendAll(result.weights, bases, guides);
-  if (!result.noisyFallback.empty())
+  if (!fallback.empty()) {
+    result.noisyFallback = Image(w, h, 1);
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
-        if (result.noisyFallback(x, y, 0) == 0.0f) continue;
+        if (!fallback[size_t(y) * size_t(w) + size_t(x)] || !std::isfinite(guides.color(x, y, 0)) ||
+            !std::isfinite(guides.color(x, y, 1)) || !std::isfinite(guides.color(x, y, 2)))
+          continue;
+        result.noisyFallback(x, y, 0) = 1.0f;
         ++result.noisyFallbackPixels;
         for (int c = 0; c < 3; ++c) {
           blends.full(x, y, c) = guides.color(x, y, c);
@@ -339,6 +338,7 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
           blends.b(x, y, c) = guides.colorB(x, y, c);
         }
       }
+  }
   result.image = std::move(blends.full);
   result.mseEstimate = estimatedBlendMse(blends.a, blends.b, guides.colorA, guides.colorB);
   result.imageA = std::move(blends.a);

@@ -3,7 +3,8 @@
 //      and rays/s, with Russian roulette (the default) and without (every path to max depth 8,
 //      comparable with the peer);
 //   2. the peer: Embree's own tutorial path tracer (Debian package embree-tools) on its Cornell
-//      box at the same size, spp and thread count, when /usr/bin/pathtracer exists;
+//      box at the same size, spp and thread count, when /usr/bin/pathtracer exists; its rays
+//      per sample are counted in a second, shorter run with peer_ray_counter preloaded;
 //   3. raw Embree: rtcIntersect1 / rtcOccluded1 (through Scene::intersect / occluded, thin
 //      wrappers) on random rays inside the same scene, no shading;
 //   4. peak resident memory after rendering 1920×1080 with K = 4 (and after building the
@@ -22,6 +23,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -120,11 +122,16 @@ void rawEmbree(const Scene& scene, int threads, size_t rayCount) {
       double(rayCount) / closest.cpu / 1e6, double(rayCount) / occluded.cpu / 1e6);
 }
 
-// Runs Embree's tutorial path tracer headless; returns false when it is not installed.
-bool peer(int size, int spp, int threads) {
+struct PeerRun {
+  bool ok = false;
+  Timing time;
+};
+
+// One headless run of Embree's tutorial path tracer; with `rayCountFile`, the ray-counting shim
+// is preloaded and writes its counts there.
+PeerRun runPeer(int size, int spp, int threads, const std::string& rayCountFile = {}) {
   const char* binary = "/usr/bin/pathtracer";
   const char* config = "/usr/share/doc/embree3/models/cornell_box.ecs";
-  if (!std::filesystem::exists(binary) || !std::filesystem::exists(config)) return false;
   const std::string out =
       (std::filesystem::temp_directory_path() / "bench_render_peer.ppm").string();
   const std::string sizeText = std::to_string(size), sppText = std::to_string(spp),
@@ -134,6 +141,10 @@ bool peer(int size, int spp, int threads) {
   const pid_t pid = fork();
   if (pid == 0) {
     if (!std::freopen("/dev/null", "w", stdout)) _exit(127);
+    if (!rayCountFile.empty()) {
+      setenv("LD_PRELOAD", CHORUS_PEER_RAY_COUNTER, 1);
+      setenv("CHORUS_RAY_COUNT_FILE", rayCountFile.c_str(), 1);
+    }
     execl(binary, binary, "-c", config, "--size", sizeText.c_str(), sizeText.c_str(), "--spp",
           sppText.c_str(), "--threads", threadText.c_str(), "-o", out.c_str(), (char*)nullptr);
     _exit(127);
@@ -141,19 +152,54 @@ bool peer(int size, int spp, int threads) {
   int status = 0;
   rusage usage{};
   wait4(pid, &status, 0, &usage);
-  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  const double cpu = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-                     1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+  PeerRun run;
+  run.time.wall = std::chrono::duration<double>(Clock::now() - start).count();
+  run.time.cpu = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
   std::filesystem::remove(out);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    std::printf("peer pathtracer failed (status %d)\n", status);
-    return true;
-  }
+  run.ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  if (!run.ok) std::printf("peer pathtracer failed (status %d)\n", status);
+  return run;
+}
+
+// The peer's rays per sample (closest-hit, occlusion), counted on a run with fewer samples per
+// pixel (the ratio does not depend on it) so that the counting costs no timed work.
+std::optional<std::pair<double, double>> peerRaysPerSample(int size, int threads) {
+  const int spp = 4;
+  const std::string countFile =
+      (std::filesystem::temp_directory_path() / "bench_render_peer_rays.txt").string();
+  std::filesystem::remove(countFile);
+  if (!runPeer(size, spp, threads, countFile).ok) return std::nullopt;
+  unsigned long long closestHit = 0, occlusion = 0;
+  FILE* file = std::fopen(countFile.c_str(), "r");
+  const bool read = file && std::fscanf(file, "%llu %llu", &closestHit, &occlusion) == 2;
+  if (file) std::fclose(file);
+  std::filesystem::remove(countFile);
+  if (!read || closestHit == 0) return std::nullopt;
   const double samples = double(size) * size * spp;
-  std::printf(
-      "%-34s %7.2f s  %6.3f M samples/s  (rays not reported; process time incl. load)  | per "
-      "CPU-s: %6.3f M samples\n",
-      "Embree tutorial pathtracer (peer)", wall, samples / wall / 1e6, samples / cpu / 1e6);
+  return std::make_pair(double(closestHit) / samples, double(occlusion) / samples);
+}
+
+// Runs Embree's tutorial path tracer headless; returns false when it is not installed.
+bool peer(int size, int spp, int threads) {
+  if (!std::filesystem::exists("/usr/bin/pathtracer") ||
+      !std::filesystem::exists("/usr/share/doc/embree3/models/cornell_box.ecs"))
+    return false;
+  const PeerRun run = runPeer(size, spp, threads);
+  if (!run.ok) return true;
+  const double samples = double(size) * size * spp;
+  const auto rays = peerRaysPerSample(size, threads);
+  std::printf("%-34s %7.2f s  %6.3f M samples/s", "Embree tutorial pathtracer (peer)",
+              run.time.wall, samples / run.time.wall / 1e6);
+  if (rays) {
+    const double perSample = rays->first + rays->second;
+    std::printf("  %6.2f M rays/s  %5.2f rays/sample (%.2f closest-hit + %.2f occlusion)",
+                samples * perSample / run.time.wall / 1e6, perSample, rays->first, rays->second);
+  } else {
+    std::printf("  (rays not counted)");
+  }
+  std::printf("  | per CPU-s: %6.3f M samples (process time incl. load)\n",
+              samples / run.time.cpu / 1e6);
   return true;
 }
 

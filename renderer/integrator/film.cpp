@@ -18,22 +18,24 @@ std::array<float, kPathSampleChannels> channels(const PathSample& s) {
 }  // namespace
 
 bool PathSample::isFinite() const {
-  for (float v : channels(*this))
-    if (!std::isfinite(v)) return false;
-  return true;
+  // A sum of floats taken in double cannot overflow, so it is finite exactly when every term is
+  // (one test instead of eleven).
+  double sum = 0;
+  for (float v : channels(*this)) sum += double(v);
+  return std::isfinite(sum);
 }
 
 bool PixelAccumulator::add(int k, const PathSample& sample) {
   if (!sample.isFinite()) return false;
   Stats& s = stats_[size_t(k)];
   ++s.count;
-  const double n = s.count;
+  const double rcpCount = 1.0 / double(s.count);  // one division for all channels
   const auto values = channels(sample);
   for (size_t c = 0; c < values.size(); ++c) {
     // Welford: mean_n = mean_{n−1} + δ/n, M2_n = M2_{n−1} + δ (x − mean_n).
     const double x = values[c];
     const double delta = x - s.mean[c];
-    s.mean[c] += delta / n;
+    s.mean[c] += delta * rcpCount;
     s.m2[c] += delta * (x - s.mean[c]);
   }
   return true;

@@ -61,6 +61,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& r
   Vec3f previousPosition = cameraRay.origin;
   float pathLength = 0;
   int volumeMaterial = -1;  // the material whose interior the path is in, or −1
+  std::optional<Bsdf> texturedBsdf;  // the current vertex's BSDF when a texture varies it
 
   for (int depth = 0;; ++depth) {
     // Sampler dimensions per bounce, in the documented order (sampler.h), drawn only when used.
@@ -102,7 +103,6 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& r
       L += beta * Le * w;
     }
 
-    std::optional<Bsdf> texturedBsdf;
     const Bsdf& bsdf = material.uniformBsdf ? *material.uniformBsdf
                                             : texturedBsdf.emplace(scene_.materialPoint(si));
     const bool transmissive = bsdf.hasTransmission();

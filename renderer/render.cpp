@@ -59,7 +59,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
   const int tilesY = (resolution.height + kTileSize - 1) / kTileSize;
   const uint64_t samplesTotal =
       uint64_t(resolution.width) * uint64_t(resolution.height) * uint64_t(options.spp);
-  std::atomic<uint64_t> rays{0}, dropped{0}, samplesDone{0};
+  std::atomic<uint64_t> rays{0}, shadowRays{0}, dropped{0}, samplesDone{0};
   std::mutex progressMutex;
 
   const auto renderTile = [&](int tile) {
@@ -67,7 +67,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
     const int x1 = std::min(x0 + kTileSize, resolution.width);
     const int y1 = std::min(y0 + kTileSize, resolution.height);
     Sampler sampler(options.seed);
-    uint64_t tileRays = 0, tileDropped = 0;
+    PathTracer::RayCounts tileRays;
+    uint64_t tileDropped = 0;
     for (int y = y0; y < y1; ++y) {
       for (int x = x0; x < x1; ++x) {
         PixelAccumulator pixel;
@@ -81,7 +82,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
         film.store(x, y, pixel);
       }
     }
-    rays += tileRays;
+    rays += tileRays.closestHit + tileRays.shadow;
+    shadowRays += tileRays.shadow;
     dropped += tileDropped;
     const uint64_t done = samplesDone +=
         uint64_t(x1 - x0) * uint64_t(y1 - y0) * uint64_t(options.spp);
@@ -110,6 +112,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
   s.renderSeconds = elapsed.seconds();
   s.samples = samplesTotal;
   s.rays = rays;
+  s.shadowRays = shadowRays;
   s.nanSamplesDropped = dropped;
   s.triangles = scene.data().triangleCount;
   return result;

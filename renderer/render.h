@@ -38,6 +38,7 @@ struct RenderStats {
   double renderSeconds = 0;
   uint64_t samples = 0;            // paths traced (width × height × spp)
   uint64_t rays = 0;               // camera, bounce and shadow rays
+  uint64_t shadowRays = 0;         // of which shadow rays
   uint64_t nanSamplesDropped = 0;  // samples with a non-finite value, not accumulated
   size_t triangles = 0;
   double samplesPerSecond() const {

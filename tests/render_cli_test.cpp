@@ -62,7 +62,12 @@ TEST(RenderCli, WritesExrPngAndStats) {
   EXPECT_EQ(stats["samples"], 12 * 8 * 8);
   EXPECT_EQ(stats["triangles"], 2);
   EXPECT_EQ(stats["nan_samples_dropped"], 0);
-  EXPECT_GE(stats["rays"].get<double>(), 12 * 8 * 8);
+  // A camera ray that hits the quad sends one shadow ray to the light in front of it and one
+  // bounce ray, which escapes (nothing else is in the scene); one that misses traces nothing else.
+  const auto rays = stats["rays"].get<uint64_t>(), shadowRays = stats["shadow_rays"].get<uint64_t>();
+  EXPECT_GT(shadowRays, 0u);
+  EXPECT_LT(shadowRays, uint64_t(12 * 8 * 8));
+  EXPECT_EQ(rays, uint64_t(12 * 8 * 8) + 2 * shadowRays);
   for (const char* key : {"load", "bvh_build", "render"})
     EXPECT_GE(stats["seconds"][key].get<double>(), 0.0);
   EXPECT_GT(stats["samples_per_second"].get<double>(), 0.0);

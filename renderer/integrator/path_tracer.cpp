@@ -49,7 +49,7 @@ bool PathTracer::unoccluded(const SurfaceInteraction& si, const Vec3f& ng,
   return !scene_.occluded(origin, target - origin, 1.0f - kShadowEpsilon);
 }
 
-PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& rays) const {
+PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& rays) const {
   PathSample out;
   FeatureRecorder features;
   float visibility = 0;
@@ -70,7 +70,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& r
                    dLightPoint = dLight + 1, dRoulette = dLightPoint + 2;
 
     Hit hit;
-    ++rays;
+    ++rays.closestHit;
     if (!scene_.intersect(ray, &hit, depth == 0)) {
       const Vec3f direction = normalize(ray.direction);
       const Rgb Le = lights_.environment().Le(direction);
@@ -139,7 +139,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, uint64_t& r
           const BsdfEval eval = bsdf.evaluate(woLocal, wiLocal);
           const Rgb f = eval.f * std::abs(wiLocal.z);
           if (!f.isBlack()) {
-            ++rays;
+            ++rays.shadow;
             if (unoccluded(si, ng, *ls)) {
               const float w = ls->isDelta ? 1.0f : powerHeuristic(ls->pdf, eval.pdf);
               L += beta * f * ls->Li * (w / ls->pdf);

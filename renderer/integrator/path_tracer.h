@@ -36,9 +36,15 @@ class PathTracer {
   PathTracer(const Scene& scene, const LightSet& lights, PathTracerSettings settings)
       : scene_(scene), lights_(lights), settings_(settings) {}
 
+  // Rays traced, by kind (Embree's closest-hit and occlusion queries differ in cost).
+  struct RayCounts {
+    uint64_t closestHit = 0;  // camera and bounce rays
+    uint64_t shadow = 0;      // next-event visibility
+  };
+
   // One path from a camera ray. Consumes sampler dimensions in the order documented in
-  // renderer/sampling/sampler.h. `rays` counts every ray traced (camera, bounce and shadow).
-  PathSample trace(const Ray& cameraRay, Sampler& sampler, uint64_t& rays) const;
+  // renderer/sampling/sampler.h; adds the rays it traces to `rays`.
+  PathSample trace(const Ray& cameraRay, Sampler& sampler, RayCounts& rays) const;
 
  private:
   bool unoccluded(const SurfaceInteraction& si, const Vec3f& ng, const LightSample& light) const;

@@ -73,6 +73,7 @@ nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderStats& s,
   j["samples"] = s.samples;
   j["samples_per_second"] = s.samplesPerSecond();
   j["rays"] = s.rays;
+  j["shadow_rays"] = s.shadowRays;
   j["rays_per_second"] = s.raysPerSecond();
   j["triangles"] = s.triangles;
   j["nan_samples_dropped"] = s.nanSamplesDropped;

@@ -79,8 +79,15 @@ void reportRender(const char* label, const RenderStats& s, const Timing& t) {
 }
 
 // Random rays from inside the scene bounds (shrunk to 90%) in uniform directions; the fastest of
-// `rounds` passes. Returns the closest-hit rate (rays per wall second).
-double rawEmbree(const Scene& scene, int threads, size_t rayCount, int rounds) {
+// `rounds` passes. Returns the rates (rays per wall second).
+struct RawRates {
+  double closestHit = 0, occlusion = 0;
+  // The rate of a mix with `shadowShare` occlusion rays, each kind at its own raw rate.
+  double mixed(double shadowShare) const {
+    return 1.0 / ((1.0 - shadowShare) / closestHit + shadowShare / occlusion);
+  }
+};
+RawRates rawEmbree(const Scene& scene, int threads, size_t rayCount, int rounds) {
   const Bounds3f b = scene.bounds();
   std::vector<Ray> rays(rayCount);
   std::mt19937 rng(1);
@@ -128,7 +135,7 @@ double rawEmbree(const Scene& scene, int threads, size_t rayCount, int rounds) {
       "raw Embree (random rays)", double(rayCount) / closest.wall / 1e6,
       100.0 * double(closestHits) / double(rayCount), double(rayCount) / occluded.wall / 1e6,
       double(rayCount) / closest.cpu / 1e6, double(rayCount) / occluded.cpu / 1e6);
-  return double(rayCount) / closest.wall;
+  return {double(rayCount) / closest.wall, double(rayCount) / occluded.wall};
 }
 
 struct PeerRun {
@@ -280,14 +287,21 @@ int main(int argc, char** argv) {
       peerSamplesPerSecond = reportPeer(*peerRun, size, spp, threads);
     else
       std::printf("peer: /usr/bin/pathtracer not run\n");
-    const double rawClosestHit = rawEmbree(scene, threads, 4'000'000, repeat);
+    const RawRates raw = rawEmbree(scene, threads, 4'000'000, repeat);
     if (peerSamplesPerSecond > 0)
       std::printf("ratios: samples/s %.2fx the peer's with roulette, %.2fx at depth 8 without; ",
                   roulette->stats.samplesPerSecond() / peerSamplesPerSecond,
                   noRoulette->stats.samplesPerSecond() / peerSamplesPerSecond);
-    std::printf("rays/s %.0f%% / %.0f%% of the raw closest-hit rate\n",
-                100.0 * roulette->stats.raysPerSecond() / rawClosestHit,
-                100.0 * noRoulette->stats.raysPerSecond() / rawClosestHit);
+    const auto shadowShare = [](const RenderStats& s) {
+      return double(s.shadowRays) / double(s.rays);
+    };
+    std::printf(
+        "rays/s %.0f%% / %.0f%% of raw Embree's closest-hit rate, %.0f%% / %.0f%% of its rate for "
+        "the same mix of closest-hit and occlusion rays\n",
+        100.0 * roulette->stats.raysPerSecond() / raw.closestHit,
+        100.0 * noRoulette->stats.raysPerSecond() / raw.closestHit,
+        100.0 * roulette->stats.raysPerSecond() / raw.mixed(shadowShare(roulette->stats)),
+        100.0 * noRoulette->stats.raysPerSecond() / raw.mixed(shadowShare(noRoulette->stats)));
 
     if (!skipMemory) {
       RenderOptions big;

@@ -130,6 +130,33 @@ TEST(Sampler, DrawsDoNotDependOnHistory) {
   }
 }
 
+// getBounce is the five separate draws of a vertex, bit for bit, whichever of them were drawn
+// before, for cached and uncached dimensions alike (first = 60 straddles the cache's end).
+TEST(Sampler, BounceDrawsEqualTheSeparateDraws) {
+  Sampler batched(11), separate(11);
+  for (int pixel = 0; pixel < 40; ++pixel) {
+    for (uint32_t i = 0; i < 3; ++i) {
+      for (int k = 0; k < 4; ++k) {
+        batched.startPixelSample(pixel % 7, pixel / 7, i, k);
+        separate.startPixelSample(pixel % 7, pixel / 7, i, k);
+        for (uint32_t first : {2u, 9u, 16u, 60u, 100u}) {
+          if (pixel % 3 == 0) batched.get1DAt(first + 3);  // a cached seed or not beforehand
+          const Sampler::BounceDraws d = batched.getBounce(first);
+          const Vec2f direction = separate.get2DAt(first + 1),
+                      lightPoint = separate.get2DAt(first + 4);
+          ASSERT_EQ(d.lobe, separate.get1DAt(first));
+          ASSERT_EQ(d.direction.x, direction.x);
+          ASSERT_EQ(d.direction.y, direction.y);
+          ASSERT_EQ(d.light, separate.get1DAt(first + 3));
+          ASSERT_EQ(d.lightPoint.x, lightPoint.x);
+          ASSERT_EQ(d.lightPoint.y, lightPoint.y);
+          ASSERT_EQ(d.roulette, separate.get1DAt(first + 6));
+        }
+      }
+    }
+  }
+}
+
 TEST(Sampler, FirstSamplesAreUniformAcrossPixels) {
   Sampler sampler(5);
   const int grid = 16, pixels = 256 * 64;

@@ -82,8 +82,6 @@ class Bsdf {
   // Transmits light at all (so the integrator keeps transmission paths and shadow rays
   // pass thin-walled surfaces only where this is true).
   bool hasTransmission() const { return transmits_; }
-  // sample() reads its lobe choice uLobe (a single Lambertian lobe does not).
-  bool choosesLobe() const { return !lambertian_; }
   // The value recorded in the albedo feature buffer: the material's overall reflectance colour
   // (baseColor for diffuse and metals, weighted by the lobe mix).
   Rgb albedo() const { return albedo_; }

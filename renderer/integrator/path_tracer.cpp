@@ -64,10 +64,9 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
   std::optional<Bsdf> texturedBsdf;  // the current vertex's BSDF when a texture varies it
 
   for (int depth = 0;; ++depth) {
-    // Sampler dimensions per bounce, in the documented order (sampler.h), drawn only when used.
-    const uint32_t bounceDimensions = sampler.reserve(7);
-    const uint32_t dLobe = bounceDimensions, dDirection = dLobe + 1, dLight = dDirection + 2,
-                   dLightPoint = dLight + 1, dRoulette = dLightPoint + 2;
+    // Sampler dimensions per bounce, in the documented order (sampler.h), drawn together once
+    // the path has a vertex to scatter from.
+    const uint32_t bounceDimensions = sampler.reserve(Sampler::kBounceDimensions);
 
     Hit hit;
     ++rays.closestHit;
@@ -127,12 +126,13 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
     if (!features.locked)
       features.record(beta * bsdf.albedo(), faceForward(frame.z, wo), pathLength);
     if (depth >= settings_.maxDepth) break;
+    const Sampler::BounceDraws u = sampler.getBounce(bounceDimensions);
 
     // Next-event estimation.
     bool lightVisible = false;
     if (!specular && !lights_.empty()) {
       if (const auto ls =
-              lights_.sample(si.position, sampler.get1DAt(dLight), sampler.get2DAt(dLightPoint))) {
+              lights_.sample(si.position, u.light, u.lightPoint)) {
         const Vec3f wiLocal = frame.toLocal(ls->wi);
         const bool sameSide = (dot(ls->wi, ng) > 0) == (dot(wo, ng) > 0);
         if (transmissive || sameSide) {
@@ -155,8 +155,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
     }
 
     // Continue the path by sampling the BSDF.
-    const float uLobe = bsdf.choosesLobe() ? sampler.get1DAt(dLobe) : 0.0f;
-    const auto bs = bsdf.sample(woLocal, uLobe, sampler.get2DAt(dDirection));
+    const auto bs = bsdf.sample(woLocal, u.lobe, u.direction);
     if (!bs || !(bs->pdf > 0) || bs->f.isBlack()) break;
     const Vec3f wi = frame.fromLocal(bs->wi);
     // Reject directions whose side of the geometric surface contradicts the lobe (possible
@@ -179,7 +178,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
 
     if (depth + 1 >= settings_.rouletteStartDepth) {
       const float survive = std::min(1.0f, (beta * etaScale).maxComponent());
-      if (!(sampler.get1DAt(dRoulette) < survive)) break;
+      if (!(u.roulette < survive)) break;
       beta = beta / survive;
     }
   }

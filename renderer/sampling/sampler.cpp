@@ -91,6 +91,21 @@ inline uint32_t reversedSobolDimension1(uint32_t z) {
          kReversedSobolDimension1[2][(z >> 16) & 0xffu] ^ kReversedSobolDimension1[3][z >> 24];
 }
 
+#if defined(__SSE4_1__)
+// lowerBitsPermutation in each 32-bit lane.
+inline __m128i lowerBitsPermutation4(__m128i x, __m128i seed) {
+  const auto times = [](__m128i v, uint32_t c) { return _mm_mullo_epi32(v, _mm_set1_epi32(int(c))); };
+  x = _mm_add_epi32(x, seed);
+  x = _mm_xor_si128(x, times(x, 0xf9b439fau));
+  x = _mm_mullo_epi32(x, _mm_or_si128(_mm_srli_epi32(seed, 16), _mm_set1_epi32(1)));
+  x = _mm_xor_si128(x, times(x, 0x91d93086u));
+  x = _mm_add_epi32(x, times(seed, 0xa05f1119u));
+  x = _mm_xor_si128(x, times(x, 0x8142c8eau));
+  x = _mm_xor_si128(x, times(x, 0x3ceaaf36u));
+  return x;
+}
+#endif
+
 // The top 24 bits as a float in [0, 1): exact, and never rounds up to 1.
 inline float toUnitFloat(uint32_t x) {
   return float(x >> 8) * 0x1p-24f;
@@ -117,12 +132,15 @@ inline uint32_t reverseBitsFast(uint32_t x) {
   return uint32_t(_mm_cvtsi128_si32(reverseLaneBits(_mm_cvtsi32_si128(int(x)))));
 }
 
+// toUnitFloat(reverseBits(lane)) of every lane.
+inline __m128 reversedUnitFloats4(__m128i v) {
+  return _mm_mul_ps(_mm_cvtepi32_ps(_mm_srli_epi32(reverseLaneBits(v), 8)), _mm_set1_ps(0x1p-24f));
+}
+
 // toUnitFloat(reverseBits(x)), toUnitFloat(reverseBits(y)), both at once.
 inline Vec2f reversedUnitFloats(uint32_t x, uint32_t y) {
-  const __m128i v = reverseLaneBits(_mm_insert_epi32(_mm_cvtsi32_si128(int(x)), int(y), 1));
-  const __m128 f = _mm_mul_ps(_mm_cvtepi32_ps(_mm_srli_epi32(v, 8)), _mm_set1_ps(0x1p-24f));
   float lanes[4];
-  _mm_storeu_ps(lanes, f);
+  _mm_storeu_ps(lanes, reversedUnitFloats4(_mm_insert_epi32(_mm_cvtsi32_si128(int(x)), int(y), 1)));
   return {lanes[0], lanes[1]};
 }
 #else
@@ -197,6 +215,39 @@ float Sampler::get1DAt(uint32_t dimension) {
   const uint32_t z = lowerBitsPermutation(reversedIndex_, uint32_t(h));
   return toUnitFloat(reverseBitsFast(lowerBitsPermutation(reverseBitsFast(z), uint32_t(h >> 32))));
 }
+
+#if defined(__SSE4_1__)
+// The steps of get1DAt / get2DAt, each for all five draws at once: the shuffled indices z, then
+// the scrambles of the first coordinates (of reverseBits(z)) and of the two second coordinates
+// (of the second Sobol dimension of z), then the reversals into floats.
+Sampler::BounceDraws Sampler::getBounce(uint32_t first) {
+  const DimensionSeeds lobe = seeds(first), direction = seeds(first + 1), light = seeds(first + 3),
+                       lightPoint = seeds(first + 4), roulette = seeds(first + 6);
+  const auto low = [](uint64_t h) { return int(uint32_t(h)); };
+  const auto high = [](uint64_t h) { return int(uint32_t(h >> 32)); };
+  const __m128i z = lowerBitsPermutation4(
+      _mm_set1_epi32(int(reversedIndex_)),
+      _mm_setr_epi32(low(lobe.first), low(direction.first), low(light.first), low(lightPoint.first)));
+  const uint32_t zRoulette = lowerBitsPermutation(reversedIndex_, uint32_t(roulette.first));
+  const __m128i firstCoordinates = lowerBitsPermutation4(
+      reverseLaneBits(z), _mm_setr_epi32(high(lobe.first), high(direction.first),
+                                         high(light.first), high(lightPoint.first)));
+  const __m128i otherCoordinates = lowerBitsPermutation4(
+      _mm_setr_epi32(int(reversedSobolDimension1(uint32_t(_mm_extract_epi32(z, 1)))),
+                     int(reversedSobolDimension1(uint32_t(_mm_extract_epi32(z, 3)))),
+                     int(reverseBitsFast(zRoulette)), 0),
+      _mm_setr_epi32(low(direction.second), low(lightPoint.second), high(roulette.first), 0));
+  float a[4], b[4];
+  _mm_storeu_ps(a, reversedUnitFloats4(firstCoordinates));
+  _mm_storeu_ps(b, reversedUnitFloats4(otherCoordinates));
+  return {a[0], {a[1], b[0]}, a[2], {a[3], b[1]}, b[2]};
+}
+#else
+Sampler::BounceDraws Sampler::getBounce(uint32_t first) {
+  return {get1DAt(first), get2DAt(first + 1), get1DAt(first + 3), get2DAt(first + 4),
+          get1DAt(first + 6)};
+}
+#endif
 
 Vec2f Sampler::getPixel2D() {
   return get2D();

@@ -64,7 +64,8 @@ TEST(RenderCli, WritesExrPngAndStats) {
   EXPECT_EQ(stats["nan_samples_dropped"], 0);
   // A camera ray that hits the quad sends one shadow ray to the light in front of it and one
   // bounce ray, which escapes (nothing else is in the scene); one that misses traces nothing else.
-  const auto rays = stats["rays"].get<uint64_t>(), shadowRays = stats["shadow_rays"].get<uint64_t>();
+  const auto rays = stats["rays"].get<uint64_t>(),
+             shadowRays = stats["shadow_rays"].get<uint64_t>();
   EXPECT_GT(shadowRays, 0u);
   EXPECT_LT(shadowRays, uint64_t(12 * 8 * 8));
   EXPECT_EQ(rays, uint64_t(12 * 8 * 8) + 2 * shadowRays);
@@ -132,9 +133,9 @@ TEST(RenderCli, FailsCleanlyOnBadInput) {
                      "--denoise nfor,rdfc,atrous needs 4 sub-buffers", out);
   expectCleanFailure({"render", scene.string(), "--combine", "oracle", "--out", o},
                      "needs a reference", out);
-  expectCleanFailure({"render", scene.string(), "--reference", (dir / "ref.exr").string(),
-                      "--out", o},
-                     "ref.exr: no such file", out);
+  expectCleanFailure(
+      {"render", scene.string(), "--reference", (dir / "ref.exr").string(), "--out", o},
+      "ref.exr: no such file", out);
   expectCleanFailure({"render", scene.string(), "--env", (dir / "sky.hdr").string(), "--out", o},
                      "sky.hdr: no such file", out);
   expectCleanFailure({"render", scene.string(), "--background", "red", "--out", o},
@@ -149,7 +150,7 @@ TEST(RenderCli, FailsCleanlyOnBadInput) {
   std::ofstream(dir / "file") << "x";
   expectCleanFailure({"render", scene.string(), "--spp", "1", "--width", "4", "--denoise", "none",
                       "--out", (dir / "file").string()},
-      "file", dir / "file");
+                     "file", dir / "file");
 }
 
 json readJson(const std::filesystem::path& file) {
@@ -163,8 +164,8 @@ TEST(RenderCli, DenoisesInProcessLikeChorusDenoiseOnTheWrittenRender) {
   TempDir dir;
   const auto scene = test::sourceDir() / "scenes" / "cornell-box.gltf";
   const std::string size[] = {"--width", "32", "--seed", "1"};
-  auto r = runChorus({"render", scene.string(), size[0], size[1], size[2], size[3], "--spp",
-                      "1024", "--denoise", "none", "--out", (dir / "ref").string()});
+  auto r = runChorus({"render", scene.string(), size[0], size[1], size[2], size[3], "--spp", "1024",
+                      "--denoise", "none", "--out", (dir / "ref").string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const auto out = dir / "out";
   r = runChorus({"render", scene.string(), size[0], size[1], "--spp", "8", "--denoise",
@@ -188,8 +189,8 @@ TEST(RenderCli, DenoisesInProcessLikeChorusDenoiseOnTheWrittenRender) {
   const Image inProcess = readExrLayer(out / "denoised.exr");
   const Image fromFile = readExrLayer(dir / "cli" / "ensemble.exr");
   ASSERT_TRUE(inProcess.sameSize(fromFile));
-  EXPECT_TRUE(std::equal(inProcess.values().begin(), inProcess.values().end(),
-                         fromFile.values().begin()));
+  EXPECT_TRUE(
+      std::equal(inProcess.values().begin(), inProcess.values().end(), fromFile.values().begin()));
   const std::vector<ExrLayer> weights = readExr(out / "weights.exr");
   ASSERT_EQ(weights.size(), 3u);
   EXPECT_EQ(weights[0].name, "atrous");
@@ -201,9 +202,9 @@ TEST(RenderCli, DenoisesInProcessLikeChorusDenoiseOnTheWrittenRender) {
 
   const json stats = readJson(out / "stats.json");
   EXPECT_EQ(stats["splits"], 2);  // neither member needs halves of its own input
-  for (const char* stage : {"render", "write render", "atrous/A", "atrous/B", "atrous/full",
-                            "jnlm/A", "jnlm/B", "jnlm/full", "bases", "solve", "filter", "blend",
-                            "write denoised", "total"})
+  for (const char* stage :
+       {"render", "write render", "atrous/A", "atrous/B", "atrous/full", "jnlm/A", "jnlm/B",
+        "jnlm/full", "bases", "solve", "filter", "blend", "write denoised", "total"})
     EXPECT_GE(stats["seconds"][stage].get<double>(), 0.0) << stage;
   EXPECT_EQ(stats["denoise"]["methods"], json({"atrous", "jnlm"}));
   size_t fallbackPixels = 0;
@@ -228,7 +229,8 @@ TEST(RenderCli, PreviewWritesOnlyThePngAndStats) {
   EXPECT_EQ(files, (std::vector<std::string>{"denoised.png", "stats.json"}));
   const json stats = readJson(out / "stats.json");
   EXPECT_EQ(stats["spp"], 4);
-  EXPECT_EQ(stats["denoise"]["methods"], json({"atrous", "atrous:iterations=4:sigmaL=8:sigmaN=16"}));
+  EXPECT_EQ(stats["denoise"]["methods"],
+            json({"atrous", "atrous:iterations=4:sigmaL=8:sigmaN=16"}));
   EXPECT_EQ(stats["denoise"]["weight_filter"], "none");
   EXPECT_EQ(stats["denoise"]["image_prior"], 0.0);
   EXPECT_EQ(stats["denoise"]["plausibility"], 4.0);

@@ -60,7 +60,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
   float previousPdf = 0;
   Vec3f previousPosition = cameraRay.origin;
   float pathLength = 0;
-  int volumeMaterial = -1;  // the material whose interior the path is in, or −1
+  int volumeMaterial = -1;           // the material whose interior the path is in, or −1
   std::optional<Bsdf> texturedBsdf;  // the current vertex's BSDF when a texture varies it
 
   for (int depth = 0;; ++depth) {
@@ -131,8 +131,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
     // Next-event estimation.
     bool lightVisible = false;
     if (!specular && !lights_.empty()) {
-      if (const auto ls =
-              lights_.sample(si.position, u.light, u.lightPoint)) {
+      if (const auto ls = lights_.sample(si.position, u.light, u.lightPoint)) {
         const Vec3f wiLocal = frame.toLocal(ls->wi);
         const bool sameSide = (dot(ls->wi, ng) > 0) == (dot(wo, ng) > 0);
         if (transmissive || sameSide) {

@@ -92,9 +92,11 @@ inline uint32_t reversedSobolDimension1(uint32_t z) {
 }
 
 #if defined(__SSE4_1__)
-// lowerBitsPermutation in each 32-bit lane.
+// lowerBitsPermutation in each 32-bit lane (the same steps; sampler_test checks that they agree).
 inline __m128i lowerBitsPermutation4(__m128i x, __m128i seed) {
-  const auto times = [](__m128i v, uint32_t c) { return _mm_mullo_epi32(v, _mm_set1_epi32(int(c))); };
+  const auto times = [](__m128i v, uint32_t c) {
+    return _mm_mullo_epi32(v, _mm_set1_epi32(int(c)));
+  };
   x = _mm_add_epi32(x, seed);
   x = _mm_xor_si128(x, times(x, 0xf9b439fau));
   x = _mm_mullo_epi32(x, _mm_or_si128(_mm_srli_epi32(seed, 16), _mm_set1_epi32(1)));
@@ -118,14 +120,15 @@ inline float toUnitFloat(uint32_t x) {
 inline __m128i reverseLaneBits(__m128i v) {
   const __m128i lowNibble = _mm_set1_epi8(0x0f);
   // reverse(n) for a nibble n, and reverse(n) << 4.
-  const __m128i reversed = _mm_setr_epi8(0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5,
-                                         0xd, 0x3, 0xb, 0x7, 0xf);
+  const __m128i reversed =
+      _mm_setr_epi8(0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf);
   const __m128i reversedHigh = _mm_slli_epi16(reversed, 4);  // no byte exceeds 0xf: no carry
   const __m128i low = _mm_and_si128(v, lowNibble);
   const __m128i high = _mm_and_si128(_mm_srli_epi16(v, 4), lowNibble);
   const __m128i bytes =
       _mm_or_si128(_mm_shuffle_epi8(reversedHigh, low), _mm_shuffle_epi8(reversed, high));
-  return _mm_shuffle_epi8(bytes, _mm_setr_epi8(3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12));
+  return _mm_shuffle_epi8(bytes,
+                          _mm_setr_epi8(3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12));
 }
 
 inline uint32_t reverseBitsFast(uint32_t x) {
@@ -225,13 +228,13 @@ Sampler::BounceDraws Sampler::getBounce(uint32_t first) {
                        lightPoint = seeds(first + 4), roulette = seeds(first + 6);
   const auto low = [](uint64_t h) { return int(uint32_t(h)); };
   const auto high = [](uint64_t h) { return int(uint32_t(h >> 32)); };
-  const __m128i z = lowerBitsPermutation4(
-      _mm_set1_epi32(int(reversedIndex_)),
-      _mm_setr_epi32(low(lobe.first), low(direction.first), low(light.first), low(lightPoint.first)));
+  const __m128i z = lowerBitsPermutation4(_mm_set1_epi32(int(reversedIndex_)),
+                                          _mm_setr_epi32(low(lobe.first), low(direction.first),
+                                                         low(light.first), low(lightPoint.first)));
   const uint32_t zRoulette = lowerBitsPermutation(reversedIndex_, uint32_t(roulette.first));
   const __m128i firstCoordinates = lowerBitsPermutation4(
-      reverseLaneBits(z), _mm_setr_epi32(high(lobe.first), high(direction.first),
-                                         high(light.first), high(lightPoint.first)));
+      reverseLaneBits(z), _mm_setr_epi32(high(lobe.first), high(direction.first), high(light.first),
+                                         high(lightPoint.first)));
   const __m128i otherCoordinates = lowerBitsPermutation4(
       _mm_setr_epi32(int(reversedSobolDimension1(uint32_t(_mm_extract_epi32(z, 1)))),
                      int(reversedSobolDimension1(uint32_t(_mm_extract_epi32(z, 3)))),

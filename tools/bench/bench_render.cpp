@@ -31,10 +31,10 @@
 #include <vector>
 
 #include "denoise/buffers/buffers_exr.h"
+#include "denoise/util/memory_reuse.h"
 #include "renderer/render.h"
 #include "renderer/sampling/warps.h"
 #include "renderer/scene/gltf_loader.h"
-#include "denoise/util/memory_reuse.h"
 
 namespace {
 

@@ -33,8 +33,11 @@ constexpr uint32_t reverseBits(uint32_t x) {
 // A seeded permutation of 32-bit words in which output bit k depends only on input bits 0..k
 // (Laine & Karras 2011): additions, odd multiplications and x ^= x * even all have this
 // property. Applied to bit-reversed values it flips each bit depending on all more significant
-// bits, which is Owen's nested uniform scrambling (Burley 2020, §3).
-inline uint32_t lowerBitsPermutation(uint32_t x, uint32_t seed) {
+// bits, which is Owen's nested uniform scrambling (Burley 2020, §3). `Word` is uint32_t, or
+// Lanes (four words side by side, permuted each with its own seed).
+using Lanes = uint32_t __attribute__((vector_size(16)));
+template <typename Word>
+inline Word lowerBitsPermutation(Word x, Word seed) {
   x += seed;
   x ^= x * 0xf9b439fau;
   x *= (seed >> 16) | 1u;
@@ -90,23 +93,6 @@ inline uint32_t reversedSobolDimension1(uint32_t z) {
   return kReversedSobolDimension1[0][z & 0xffu] ^ kReversedSobolDimension1[1][(z >> 8) & 0xffu] ^
          kReversedSobolDimension1[2][(z >> 16) & 0xffu] ^ kReversedSobolDimension1[3][z >> 24];
 }
-
-#if defined(__SSE4_1__)
-// lowerBitsPermutation in each 32-bit lane (the same steps; sampler_test checks that they agree).
-inline __m128i lowerBitsPermutation4(__m128i x, __m128i seed) {
-  const auto times = [](__m128i v, uint32_t c) {
-    return _mm_mullo_epi32(v, _mm_set1_epi32(int(c)));
-  };
-  x = _mm_add_epi32(x, seed);
-  x = _mm_xor_si128(x, times(x, 0xf9b439fau));
-  x = _mm_mullo_epi32(x, _mm_or_si128(_mm_srli_epi32(seed, 16), _mm_set1_epi32(1)));
-  x = _mm_xor_si128(x, times(x, 0x91d93086u));
-  x = _mm_add_epi32(x, times(seed, 0xa05f1119u));
-  x = _mm_xor_si128(x, times(x, 0x8142c8eau));
-  x = _mm_xor_si128(x, times(x, 0x3ceaaf36u));
-  return x;
-}
-#endif
 
 // The top 24 bits as a float in [0, 1): exact, and never rounds up to 1.
 inline float toUnitFloat(uint32_t x) {
@@ -226,23 +212,22 @@ float Sampler::get1DAt(uint32_t dimension) {
 Sampler::BounceDraws Sampler::getBounce(uint32_t first) {
   const DimensionSeeds lobe = seeds(first), direction = seeds(first + 1), light = seeds(first + 3),
                        lightPoint = seeds(first + 4), roulette = seeds(first + 6);
-  const auto low = [](uint64_t h) { return int(uint32_t(h)); };
-  const auto high = [](uint64_t h) { return int(uint32_t(h >> 32)); };
-  const __m128i z = lowerBitsPermutation4(_mm_set1_epi32(int(reversedIndex_)),
-                                          _mm_setr_epi32(low(lobe.first), low(direction.first),
-                                                         low(light.first), low(lightPoint.first)));
-  const uint32_t zRoulette = lowerBitsPermutation(reversedIndex_, uint32_t(roulette.first));
-  const __m128i firstCoordinates = lowerBitsPermutation4(
-      reverseLaneBits(z), _mm_setr_epi32(high(lobe.first), high(direction.first), high(light.first),
-                                         high(lightPoint.first)));
-  const __m128i otherCoordinates = lowerBitsPermutation4(
-      _mm_setr_epi32(int(reversedSobolDimension1(uint32_t(_mm_extract_epi32(z, 1)))),
-                     int(reversedSobolDimension1(uint32_t(_mm_extract_epi32(z, 3)))),
-                     int(reverseBitsFast(zRoulette)), 0),
-      _mm_setr_epi32(low(direction.second), low(lightPoint.second), high(roulette.first), 0));
+  const auto low = [](uint64_t h) { return uint32_t(h); };
+  const auto high = [](uint64_t h) { return uint32_t(h >> 32); };
+  const Lanes z = lowerBitsPermutation(
+      Lanes{reversedIndex_, reversedIndex_, reversedIndex_, reversedIndex_},
+      Lanes{low(lobe.first), low(direction.first), low(light.first), low(lightPoint.first)});
+  const uint32_t zRoulette = lowerBitsPermutation(reversedIndex_, low(roulette.first));
+  const Lanes firstCoordinates = lowerBitsPermutation(
+      Lanes(reverseLaneBits(__m128i(z))),
+      Lanes{high(lobe.first), high(direction.first), high(light.first), high(lightPoint.first)});
+  const Lanes otherCoordinates = lowerBitsPermutation(
+      Lanes{reversedSobolDimension1(z[1]), reversedSobolDimension1(z[3]),
+            reverseBitsFast(zRoulette), 0},
+      Lanes{low(direction.second), low(lightPoint.second), high(roulette.first), 0});
   float a[4], b[4];
-  _mm_storeu_ps(a, reversedUnitFloats4(firstCoordinates));
-  _mm_storeu_ps(b, reversedUnitFloats4(otherCoordinates));
+  _mm_storeu_ps(a, reversedUnitFloats4(__m128i(firstCoordinates)));
+  _mm_storeu_ps(b, reversedUnitFloats4(__m128i(otherCoordinates)));
   return {a[0], {a[1], b[0]}, a[2], {a[3], b[1]}, b[2]};
 }
 #else

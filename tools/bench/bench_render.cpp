@@ -42,11 +42,19 @@ using namespace chorus;
 using namespace chorus::render;
 using Clock = std::chrono::steady_clock;
 
+// Embree's tutorial path tracer (Debian package embree-tools) and its Cornell box.
+constexpr const char* kPeerBinary = "/usr/bin/pathtracer";
+constexpr const char* kPeerScene = "/usr/share/doc/embree3/models/cornell_box.ecs";
+
+double cpuSeconds(const rusage& u) {
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
 double cpuSeconds(int who) {
   rusage u{};
   getrusage(who, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  return cpuSeconds(u);
 }
 
 double peakMemoryMB() {
@@ -146,8 +154,6 @@ struct PeerRun {
 // One headless run of Embree's tutorial path tracer; with `rayCountFile`, the ray-counting shim
 // is preloaded and writes its counts there.
 PeerRun runPeer(int size, int spp, int threads, const std::string& rayCountFile = {}) {
-  const char* binary = "/usr/bin/pathtracer";
-  const char* config = "/usr/share/doc/embree3/models/cornell_box.ecs";
   const std::string out =
       (std::filesystem::temp_directory_path() / "bench_render_peer.ppm").string();
   const std::string sizeText = std::to_string(size), sppText = std::to_string(spp),
@@ -161,8 +167,9 @@ PeerRun runPeer(int size, int spp, int threads, const std::string& rayCountFile 
       setenv("LD_PRELOAD", CHORUS_PEER_RAY_COUNTER, 1);
       setenv("CHORUS_RAY_COUNT_FILE", rayCountFile.c_str(), 1);
     }
-    execl(binary, binary, "-c", config, "--size", sizeText.c_str(), sizeText.c_str(), "--spp",
-          sppText.c_str(), "--threads", threadText.c_str(), "-o", out.c_str(), (char*)nullptr);
+    execl(kPeerBinary, kPeerBinary, "-c", kPeerScene, "--size", sizeText.c_str(), sizeText.c_str(),
+          "--spp", sppText.c_str(), "--threads", threadText.c_str(), "-o", out.c_str(),
+          (char*)nullptr);
     _exit(127);
   }
   int status = 0;
@@ -170,8 +177,7 @@ PeerRun runPeer(int size, int spp, int threads, const std::string& rayCountFile 
   wait4(pid, &status, 0, &usage);
   PeerRun run;
   run.time.wall = std::chrono::duration<double>(Clock::now() - start).count();
-  run.time.cpu = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-                 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+  run.time.cpu = cpuSeconds(usage);
   std::filesystem::remove(out);
   run.ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
   if (!run.ok) std::printf("peer pathtracer failed (status %d)\n", status);
@@ -180,7 +186,10 @@ PeerRun runPeer(int size, int spp, int threads, const std::string& rayCountFile 
 
 // The peer's rays per sample (closest-hit, occlusion), counted on a run with fewer samples per
 // pixel (the ratio does not depend on it) so that the counting costs no timed work.
-std::optional<std::pair<double, double>> peerRaysPerSample(int size, int threads) {
+struct RaysPerSample {
+  double closestHit = 0, occlusion = 0;
+};
+std::optional<RaysPerSample> peerRaysPerSample(int size, int threads) {
   const int spp = 4;
   const std::string countFile =
       (std::filesystem::temp_directory_path() / "bench_render_peer_rays.txt").string();
@@ -193,12 +202,11 @@ std::optional<std::pair<double, double>> peerRaysPerSample(int size, int threads
   std::filesystem::remove(countFile);
   if (!read || closestHit == 0) return std::nullopt;
   const double samples = double(size) * size * spp;
-  return std::make_pair(double(closestHit) / samples, double(occlusion) / samples);
+  return RaysPerSample{double(closestHit) / samples, double(occlusion) / samples};
 }
 
 bool peerInstalled() {
-  return std::filesystem::exists("/usr/bin/pathtracer") &&
-         std::filesystem::exists("/usr/share/doc/embree3/models/cornell_box.ecs");
+  return std::filesystem::exists(kPeerBinary) && std::filesystem::exists(kPeerScene);
 }
 
 // Prints the peer's fastest run; returns its samples per wall second.
@@ -208,9 +216,10 @@ double reportPeer(const PeerRun& run, int size, int spp, int threads) {
   std::printf("%-34s %7.2f s  %6.3f M samples/s", "Embree tutorial pathtracer (peer)",
               run.time.wall, samples / run.time.wall / 1e6);
   if (rays) {
-    const double perSample = rays->first + rays->second;
+    const double perSample = rays->closestHit + rays->occlusion;
     std::printf("  %6.2f M rays/s  %5.2f rays/sample (%.2f closest-hit + %.2f occlusion)",
-                samples * perSample / run.time.wall / 1e6, perSample, rays->first, rays->second);
+                samples * perSample / run.time.wall / 1e6, perSample, rays->closestHit,
+                rays->occlusion);
   } else {
     std::printf("  (rays not counted)");
   }

@@ -120,40 +120,43 @@ std::optional<LightSample> LightSet::sample(const Vec3f& ref, float uChoice, Vec
   const int index = choice_.sample(uChoice, &pmf);
   if (!(pmf > 0)) return std::nullopt;
   const LightRef light = lights_[size_t(index)];
-  std::optional<LightSample> s;
+  // Filled in place and returned as the one named object (no copies of the ~70-byte sample).
+  std::optional<LightSample> s(std::in_place);
+  bool found = false;
   switch (light.kind) {
     case Kind::Area:
-      s = sampleArea(areaLights_[light.index], ref, u);
+      found = sampleArea(areaLights_[light.index], ref, u, *s);
       break;
     case Kind::Punctual:
-      s = samplePunctual(scene_->data().punctualLights[light.index], ref);
+      found = samplePunctual(scene_->data().punctualLights[light.index], ref, *s);
       break;
     case Kind::Environment:
       if (const auto e = environment_.sample(u)) {
-        s = LightSample{};
         s->Li = e->Le;
         s->wi = e->wi;
         s->pdf = e->pdfSolidAngle;
         s->isInfinite = true;
+        found = true;
       }
       break;
   }
-  if (!s || !(s->pdf > 0) || s->Li.isBlack()) return std::nullopt;
-  s->pdf *= pmf;
+  if (!found || !(s->pdf > 0) || s->Li.isBlack())
+    s.reset();
+  else
+    s->pdf *= pmf;
   return s;
 }
 
-std::optional<LightSample> LightSet::sampleArea(const AreaLight& light, const Vec3f& ref,
-                                                Vec2f u) const {
-  if (!(light.area > 0)) return std::nullopt;
+bool LightSet::sampleArea(const AreaLight& light, const Vec3f& ref, Vec2f u,
+                          LightSample& s) const {
+  if (!(light.area > 0)) return false;
   const Vec2f b = sampleUniformTriangle(u);
   const float b2 = 1 - b.x - b.y;
   const Vec3f p = light.p0 * b.x + light.p1 * b.y + light.p2 * b2;
   const Vec3f toLight = p - ref;
   const float distanceSquared = lengthSquared(toLight);
-  if (!(distanceSquared > 0)) return std::nullopt;
+  if (!(distanceSquared > 0)) return false;
   const Vec3f wi = toLight / std::sqrt(distanceSquared);
-  LightSample s;
   if (light.uniform) {
     s.nLight = light.normal;
     if (light.doubleSided || dot(wi, light.normal) < 0) s.Li = light.Le;
@@ -163,33 +166,32 @@ std::optional<LightSample> LightSet::sampleArea(const AreaLight& light, const Ve
     s.Li = e.Le;
   }
   const float cosLight = std::abs(dot(s.nLight, wi));
-  if (!(cosLight > 0)) return std::nullopt;
+  if (!(cosLight > 0)) return false;
   s.wi = wi;
   s.pdf = distanceSquared / (cosLight * light.area);
   s.pLight = p;
   s.pLightError = barycentricPositionError(light.p0, light.p1, light.p2, b.x, b.y, b2);
-  return s;
+  return true;
 }
 
-std::optional<LightSample> LightSet::samplePunctual(const PunctualLightDesc& light,
-                                                    const Vec3f& ref) const {
-  LightSample s;
+bool LightSet::samplePunctual(const PunctualLightDesc& light, const Vec3f& ref,
+                              LightSample& s) const {
   s.isDelta = true;
   s.pdf = 1.0f;
   if (light.type == PunctualLightType::Directional) {
     s.wi = -light.direction;
     s.Li = light.color * light.intensity;
     s.isInfinite = true;
-    return s;
+    return true;
   }
   const Vec3f toLight = light.position - ref;
   const float distanceSquared = lengthSquared(toLight);
-  if (!(distanceSquared > 0)) return std::nullopt;
+  if (!(distanceSquared > 0)) return false;
   s.wi = toLight / std::sqrt(distanceSquared);
   s.Li = light.color * (light.intensity / distanceSquared);
   if (light.type == PunctualLightType::Spot) s.Li *= spotAttenuation(light, s.wi);
   s.pLight = light.position;
-  return s;
+  return true;
 }
 
 float LightSet::pdfAreaLight(const Vec3f& ref, const SurfaceInteraction& lightPoint) const {

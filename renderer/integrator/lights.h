@@ -60,8 +60,9 @@ class LightSet {
     Rgb Le;
   };
 
-  std::optional<LightSample> sampleArea(const AreaLight& light, const Vec3f& ref, Vec2f u) const;
-  std::optional<LightSample> samplePunctual(const PunctualLightDesc& light, const Vec3f& ref) const;
+  // Fill `s` (default-constructed) and return true, or return false when no sample results.
+  bool sampleArea(const AreaLight& light, const Vec3f& ref, Vec2f u, LightSample& s) const;
+  bool samplePunctual(const PunctualLightDesc& light, const Vec3f& ref, LightSample& s) const;
 
   const Scene* scene_;
   std::vector<AreaLight> areaLights_;  // index = SceneMesh::firstAreaLight + primID

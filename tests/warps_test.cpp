@@ -135,6 +135,24 @@ TEST(Warps, ConcentricDiskIsUniform) {
   EXPECT_NEAR(rim.x * rim.x + rim.y * rim.y, 1.0f, 1e-5f);
 }
 
+// The mapping itself equals Shirley & Chiu's formula with library sin/cos in double precision
+// (the implementation evaluates them by series) to float rounding.
+TEST(Warps, ConcentricDiskMatchesTheTextbookMap) {
+  std::mt19937 rng(22);
+  double worst = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const Vec2f u{uniform(rng), uniform(rng)};
+    const double ox = 2.0 * u.x - 1.0, oy = 2.0 * u.y - 1.0;
+    const bool xMajor = std::abs(ox) > std::abs(oy);
+    const double r = xMajor ? ox : oy;
+    const double theta = xMajor ? M_PI / 4 * (oy / ox) : M_PI / 2 - M_PI / 4 * (ox / oy);
+    const Vec2f d = sampleConcentricDisk(u);
+    worst = std::max({worst, std::abs(d.x - r * std::cos(theta)),
+                      std::abs(d.y - r * std::sin(theta))});
+  }
+  EXPECT_LT(worst, 3e-7);
+}
+
 // Barycentrics (b0, b1) of uniform points on a triangle are uniform on {b0, b1 ≥ 0, b0 + b1 ≤ 1}:
 // grid cells inside it expect n · 2 · area, cells cut by the diagonal half as much.
 TEST(Warps, TriangleIsUniform) {

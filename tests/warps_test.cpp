@@ -147,8 +147,8 @@ TEST(Warps, ConcentricDiskMatchesTheTextbookMap) {
     const double r = xMajor ? ox : oy;
     const double theta = xMajor ? M_PI / 4 * (oy / ox) : M_PI / 2 - M_PI / 4 * (ox / oy);
     const Vec2f d = sampleConcentricDisk(u);
-    worst = std::max({worst, std::abs(d.x - r * std::cos(theta)),
-                      std::abs(d.y - r * std::sin(theta))});
+    worst =
+        std::max({worst, std::abs(d.x - r * std::cos(theta)), std::abs(d.y - r * std::sin(theta))});
   }
   EXPECT_LT(worst, 3e-7);
 }

@@ -147,8 +147,7 @@ std::optional<LightSample> LightSet::sample(const Vec3f& ref, float uChoice, Vec
   return s;
 }
 
-bool LightSet::sampleArea(const AreaLight& light, const Vec3f& ref, Vec2f u,
-                          LightSample& s) const {
+bool LightSet::sampleArea(const AreaLight& light, const Vec3f& ref, Vec2f u, LightSample& s) const {
   if (!(light.area > 0)) return false;
   const Vec2f b = sampleUniformTriangle(u);
   const float b2 = 1 - b.x - b.y;

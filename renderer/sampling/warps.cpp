@@ -12,13 +12,13 @@ struct SinCos {
   float sin, cos;
 };
 SinCos sinCosQuarterPi(float x) {
+  constexpr float kSin[] = {1.0f, -1.0f / 6, 1.0f / 120, -1.0f / 5040, 1.0f / 362880};
+  constexpr float kCos[] = {1.0f, -1.0f / 2, 1.0f / 24, -1.0f / 720, 1.0f / 40320, -1.0f / 3628800};
   const float x2 = x * x;
-  const float s =
-      x * (1.0f + x2 * (-1.0f / 6 + x2 * (1.0f / 120 + x2 * (-1.0f / 5040 + x2 * (1.0f / 362880)))));
-  const float c =
-      1.0f + x2 * (-0.5f + x2 * (1.0f / 24 + x2 * (-1.0f / 720 +
-                                                    x2 * (1.0f / 40320 + x2 * (-1.0f / 3628800)))));
-  return {s, c};
+  float s = kSin[4], c = kCos[5];  // Horner's rule in x²
+  for (int i = 3; i >= 0; --i) s = kSin[i] + x2 * s;
+  for (int i = 4; i >= 0; --i) c = kCos[i] + x2 * c;
+  return {x * s, c};
 }
 
 }  // namespace

@@ -295,7 +295,7 @@ int main(int argc, char** argv) {
     if (peerRun)
       peerSamplesPerSecond = reportPeer(*peerRun, size, spp, threads);
     else
-      std::printf("peer: /usr/bin/pathtracer not run\n");
+      std::printf("peer: %s not run\n", kPeerBinary);
     const RawRates raw = rawEmbree(scene, threads, 4'000'000, repeat);
     if (peerSamplesPerSecond > 0)
       std::printf("ratios: samples/s %.2fx the peer's with roulette, %.2fx at depth 8 without; ",

@@ -3,11 +3,20 @@
 #   tools/setup.sh demo   install missing packages, build, render the default scene with denoising
 #   tools/setup.sh test   install missing packages, build, run the whole test suite (CTest)
 #   tools/setup.sh build  install missing packages and build only
+#   tools/setup.sh bench  also install the renderer benchmark's peer (embree-tools), build,
+#                         run build/bench/bench_render (about 3 minutes)
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores), CI=true adds -Werror.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 mode=${1:-demo}
+case "$mode" in
+  demo | test | build | bench) ;;
+  *)
+    echo "usage: tools/setup.sh [demo|test|build|bench]" >&2
+    exit 2
+    ;;
+esac
 build_dir=${BUILD_DIR:-build}
 jobs=${JOBS:-$(nproc)}
 
@@ -15,6 +24,8 @@ packages=(g++ cmake make pkg-config libembree-dev libtinygltf-dev libopenexr-dev
           libgtest-dev libeigen3-dev libcli11-dev libstb-dev nlohmann-json3-dev zlib1g-dev)
 # The report test loads report.html in a real browser.
 [ "$mode" = test ] && packages+=(chromium)
+# The renderer benchmark runs Embree's own tutorial path tracer as its peer.
+[ "$mode" = bench ] && packages+=(embree-tools)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -38,14 +49,13 @@ case "$mode" in
   test)
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
     ;;
+  bench)
+    "$build_dir"/bench/bench_render
+    ;;
   demo)
     out=out/cornell-box
     "$build_dir"/chorus render scenes/cornell-box.gltf --out "$out"
     echo "setup: wrote"
     ls -l "$out"
-    ;;
-  *)
-    echo "usage: tools/setup.sh [demo|test|build]" >&2
-    exit 2
     ;;
 esac

@@ -4,7 +4,7 @@
 #   tools/setup.sh test   install missing packages, build, run the whole test suite (CTest)
 #   tools/setup.sh build  install missing packages and build only
 #   tools/setup.sh bench  also install the renderer benchmark's peer (embree-tools), build,
-#                         run build/bench/bench_render (about 3 minutes)
+#                         run build/bench/bench_render (about 3 minutes after the build)
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores), CI=true adds -Werror.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -294,11 +294,14 @@ int main(int argc, char** argv) {
     double peerSamplesPerSecond = 0;
     if (peerRun)
       peerSamplesPerSecond = reportPeer(*peerRun, size, spp, threads);
+    else if (withPeer)
+      std::printf("peer: every run failed (above)\n");
     else if (skipPeer)
       std::printf("peer: not run (--skip-peer)\n");
     else
-      std::printf("peer: %s not found: install Debian's embree-tools (tools/setup.sh bench does)\n",
-                  kPeerBinary);
+      std::printf(
+          "peer: %s or %s missing: install Debian's embree-tools (tools/setup.sh bench does)\n",
+          kPeerBinary, kPeerScene);
     const RawRates raw = rawEmbree(scene, threads, 4'000'000, repeat);
     if (peerSamplesPerSecond > 0)
       std::printf("ratios: samples/s %.2fx the peer's with roulette, %.2fx at depth 8 without; ",

@@ -24,6 +24,7 @@ const std::array<float, 256>& srgbTable() {
 
 // Texel coordinate of one axis after the wrap mode.
 int wrap(int i, int size, WrapMode mode) {
+  if (unsigned(i) < unsigned(size)) return i;  // inside the image: every mode keeps it
   switch (mode) {
     case WrapMode::ClampToEdge:
       return i < 0 ? 0 : (i >= size ? size - 1 : i);
@@ -82,25 +83,29 @@ ImageDesc decodeImage(std::span<const uint8_t> bytes, const std::string& name) {
   return image;
 }
 
-std::array<float, 4> Texture::texel(int x, int y, ColorEncoding encoding) const {
-  const int ix = wrap(x, image_->width, desc_.wrapS);
-  const int iy = wrap(y, image_->height, desc_.wrapT);
+std::array<float, 4> Texture::texel(int ix, int iy, ColorEncoding encoding) const {
   const uint8_t* p = image_->rgba.data() + (size_t(iy) * size_t(image_->width) + size_t(ix)) * 4;
-  if (encoding == ColorEncoding::Srgb)
-    return {srgbByteToLinear(p[0]), srgbByteToLinear(p[1]), srgbByteToLinear(p[2]), p[3] / 255.0f};
+  if (encoding == ColorEncoding::Srgb) {
+    const std::array<float, 256>& table = srgbTable();
+    return {table[p[0]], table[p[1]], table[p[2]], p[3] / 255.0f};
+  }
   return {p[0] / 255.0f, p[1] / 255.0f, p[2] / 255.0f, p[3] / 255.0f};
 }
 
 std::array<float, 4> Texture::sample(Vec2f uv, ColorEncoding encoding) const {
-  const float x = uv.x * float(image_->width), y = uv.y * float(image_->height);
-  if (desc_.nearest) return texel(safeFloor(x), safeFloor(y), encoding);
-  // Bilinear between the four texel centres around (x, y).
+  const int w = image_->width, h = image_->height;
+  const float x = uv.x * float(w), y = uv.y * float(h);
+  if (desc_.nearest)
+    return texel(wrap(safeFloor(x), w, desc_.wrapS), wrap(safeFloor(y), h, desc_.wrapT), encoding);
+  // Bilinear between the four texel centres around (x, y); each axis is wrapped once.
   const float fx = x - 0.5f, fy = y - 0.5f;
   const int x0 = safeFloor(fx), y0 = safeFloor(fy);
   const float tx = std::abs(fx) < 1e9f ? fx - float(x0) : 0.0f;
   const float ty = std::abs(fy) < 1e9f ? fy - float(y0) : 0.0f;
-  const auto a = texel(x0, y0, encoding), b = texel(x0 + 1, y0, encoding);
-  const auto c = texel(x0, y0 + 1, encoding), d = texel(x0 + 1, y0 + 1, encoding);
+  const int ix0 = wrap(x0, w, desc_.wrapS), ix1 = wrap(x0 + 1, w, desc_.wrapS);
+  const int iy0 = wrap(y0, h, desc_.wrapT), iy1 = wrap(y0 + 1, h, desc_.wrapT);
+  const auto a = texel(ix0, iy0, encoding), b = texel(ix1, iy0, encoding);
+  const auto c = texel(ix0, iy1, encoding), d = texel(ix1, iy1, encoding);
   std::array<float, 4> out{};
   for (size_t i = 0; i < 4; ++i)
     out[i] = (1 - ty) * ((1 - tx) * a[i] + tx * b[i]) + ty * ((1 - tx) * c[i] + tx * d[i]);

@@ -34,7 +34,8 @@ class Texture {
   const ImageDesc& image() const { return *image_; }
 
  private:
-  std::array<float, 4> texel(int x, int y, ColorEncoding encoding) const;
+  // The texel at wrapped coordinates (inside the image).
+  std::array<float, 4> texel(int ix, int iy, ColorEncoding encoding) const;
 
   const ImageDesc* image_ = nullptr;
   TextureDesc desc_;

@@ -204,6 +204,11 @@ TEST(EnvironmentLight, PdfIntegratesToOneAndMatchesSamples) {
     ASSERT_TRUE(s);
     EXPECT_NEAR(env.pdfSolidAngle(s->wi) / s->pdfSolidAngle, 1.0f, 2e-3f);
     EXPECT_EQ(env.Le(s->wi).r, s->Le.r);
+    // The fused lookup of an escaping path gives the same two values, the pdf only when asked.
+    const EnvironmentLight::Arrival a = env.arrival(s->wi, true);
+    EXPECT_EQ(a.Le.r, s->Le.r);
+    EXPECT_EQ(a.pdfSolidAngle, env.pdfSolidAngle(s->wi));
+    EXPECT_EQ(env.arrival(s->wi, false).pdfSolidAngle, 0.0f);
   }
 }
 

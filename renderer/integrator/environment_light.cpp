@@ -74,9 +74,18 @@ Rgb EnvironmentLight::texel(Vec2f uv) const {
 }
 
 Rgb EnvironmentLight::Le(const Vec3f& direction) const {
-  if (!emits_) return Rgb(0.0f);
-  if (kind_ == EnvironmentDesc::Kind::Constant) return constant_;
-  return texel(directionToUv(toMap(direction)));
+  return arrival(direction, false).Le;
+}
+
+EnvironmentLight::Arrival EnvironmentLight::arrival(const Vec3f& direction, bool withPdf) const {
+  if (!emits_) return {};
+  if (kind_ == EnvironmentDesc::Kind::Constant)
+    return {constant_, withPdf ? kUniformSpherePdfSolidAngle : 0.0f};
+  const Vec3f d = toMap(direction);
+  const Vec2f uv = directionToUv(d);
+  Arrival a{texel(uv), 0.0f};
+  if (withPdf && !a.Le.isBlack()) a.pdfSolidAngle = mapPdf(d, uv);
+  return a;
 }
 
 std::optional<EnvironmentLight::Sample> EnvironmentLight::sample(Vec2f u) const {
@@ -96,9 +105,13 @@ float EnvironmentLight::pdfSolidAngle(const Vec3f& direction) const {
   if (!emits_) return 0.0f;
   if (kind_ == EnvironmentDesc::Kind::Constant) return kUniformSpherePdfSolidAngle;
   const Vec3f d = toMap(direction);
+  return mapPdf(d, directionToUv(d));
+}
+
+float EnvironmentLight::mapPdf(Vec3f d, Vec2f uv) const {
   const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - d.y * d.y));
   if (!(sinTheta > 0)) return 0.0f;
-  return distribution_.pdf(directionToUv(d)) / (2.0f * kPi * kPi * sinTheta);
+  return distribution_.pdf(uv) / (2.0f * kPi * kPi * sinTheta);
 }
 
 float EnvironmentLight::power(float sceneRadius) const {

@@ -29,6 +29,15 @@ class EnvironmentLight {
   std::optional<Sample> sample(Vec2f u) const;
   float pdfSolidAngle(const Vec3f& direction) const;
 
+  // Le(direction) and, when asked for and Le is not black, pdfSolidAngle(direction), from one
+  // mapping of the direction to the map (its acos and atan2 are most of a lookup's cost): a
+  // path that escapes after a BSDF sample needs both for MIS.
+  struct Arrival {
+    Rgb Le;
+    float pdfSolidAngle = 0;
+  };
+  Arrival arrival(const Vec3f& direction, bool withPdf) const;
+
   // Power estimate for choosing between lights: an emitter of the environment's mean radiance
   // on the scene's bounding sphere, 4π² r² L̄ (as pbrt-v4's infinite lights).
   float power(float sceneRadius) const;
@@ -37,6 +46,8 @@ class EnvironmentLight {
   Vec3f toMap(Vec3f world) const;
   Vec3f toWorld(Vec3f map) const;
   Rgb texel(Vec2f uv) const;
+  // pdfSolidAngle of map-space direction d, whose map position is uv.
+  float mapPdf(Vec3f d, Vec2f uv) const;
 
   EnvironmentDesc::Kind kind_ = EnvironmentDesc::Kind::None;
   bool emits_ = false;

@@ -207,9 +207,12 @@ float LightSet::pdfAreaLight(const Vec3f& ref, const SurfaceInteraction& lightPo
   return choice_.pmf(int(index)) * distanceSquared / (cosLight * light.area);
 }
 
-float LightSet::pdfEnvironment(const Vec3f& direction) const {
-  if (environmentIndex_ < 0) return 0.0f;
-  return choice_.pmf(environmentIndex_) * environment_.pdfSolidAngle(direction);
+EnvironmentLight::Arrival LightSet::environmentArrival(const Vec3f& direction,
+                                                      bool withPdf) const {
+  const bool sampled = environmentIndex_ >= 0;
+  EnvironmentLight::Arrival a = environment_.arrival(direction, withPdf && sampled);
+  if (sampled) a.pdfSolidAngle *= choice_.pmf(environmentIndex_);
+  return a;
 }
 
 }  // namespace chorus::render

@@ -36,10 +36,10 @@ class LightSet {
   // The pdf sample() would have for reaching emissive triangle `lightPoint` from refPosition
   // (solid angle, including the choice probability): the MIS weight of a BSDF-sampled hit.
   float pdfAreaLight(const Vec3f& refPosition, const SurfaceInteraction& lightPoint) const;
-  // Likewise for a BSDF-sampled ray escaping in direction `direction` (unit).
-  float pdfEnvironment(const Vec3f& direction) const;
+  // What a ray escaping in direction `direction` (unit) receives from the environment, and
+  // when withPdf, likewise the pdf of sampling that direction (0 where the radiance is black).
+  EnvironmentLight::Arrival environmentArrival(const Vec3f& direction, bool withPdf) const;
 
-  const EnvironmentLight& environment() const { return environment_; }
   size_t areaLightCount() const { return areaLights_.size(); }
 
  private:

@@ -72,11 +72,10 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
     ++rays.closestHit;
     if (!scene_.intersect(ray, &hit, depth == 0)) {
       const Vec3f direction = normalize(ray.direction);
-      const Rgb Le = lights_.environment().Le(direction);
-      if (!Le.isBlack()) {
-        const float w =
-            previousDelta ? 1.0f : powerHeuristic(previousPdf, lights_.pdfEnvironment(direction));
-        L += beta * Le * w;
+      const EnvironmentLight::Arrival arrival = lights_.environmentArrival(direction, !previousDelta);
+      if (!arrival.Le.isBlack()) {
+        const float w = previousDelta ? 1.0f : powerHeuristic(previousPdf, arrival.pdfSolidAngle);
+        L += beta * arrival.Le * w;
       }
       if (!features.locked) {
         features.record(beta, Vec3f{}, 0.0f);

@@ -207,8 +207,7 @@ float LightSet::pdfAreaLight(const Vec3f& ref, const SurfaceInteraction& lightPo
   return choice_.pmf(int(index)) * distanceSquared / (cosLight * light.area);
 }
 
-EnvironmentLight::Arrival LightSet::environmentArrival(const Vec3f& direction,
-                                                      bool withPdf) const {
+EnvironmentLight::Arrival LightSet::environmentArrival(const Vec3f& direction, bool withPdf) const {
   const bool sampled = environmentIndex_ >= 0;
   EnvironmentLight::Arrival a = environment_.arrival(direction, withPdf && sampled);
   if (sampled) a.pdfSolidAngle *= choice_.pmf(environmentIndex_);

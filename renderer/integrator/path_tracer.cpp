@@ -72,7 +72,8 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
     ++rays.closestHit;
     if (!scene_.intersect(ray, &hit, depth == 0)) {
       const Vec3f direction = normalize(ray.direction);
-      const EnvironmentLight::Arrival arrival = lights_.environmentArrival(direction, !previousDelta);
+      const EnvironmentLight::Arrival arrival =
+          lights_.environmentArrival(direction, !previousDelta);
       if (!arrival.Le.isBlack()) {
         const float w = previousDelta ? 1.0f : powerHeuristic(previousPdf, arrival.pdfSolidAngle);
         L += beta * arrival.Le * w;

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <vector>
@@ -175,6 +177,43 @@ TEST(PiecewiseConstant2D, SamplesStayInTheirCellAtCellBoundaries) {
       EXPECT_LT(p.y, 1.0f);
       EXPECT_EQ(pdf, distribution.pdf(p)) << ux << ", " << uy;
     }
+}
+
+TEST(PiecewiseConstant2D, WideRowsInvertTheirCdfExactly) {
+  // As wide as a 1k environment map, with runs of empty cells and spikes, so that the search
+  // goes through the guide tables: every u (a fine sweep that includes the guides' own steps,
+  // multiples of 1/64) must land in the cell a brute-force inversion of the cdf gives.
+  const int nu = 1024, nv = 2;
+  std::vector<float> f(size_t(nu * nv));
+  for (int i = 0; i < nu; ++i) {
+    f[size_t(i)] = (i / 40) % 3 == 0 ? 0.0f : float(1 + i % 7);  // empty runs of 40
+    f[size_t(nu + i)] = i % 97 == 0 ? 500.0f : 0.01f;            // spikes on a dim floor
+  }
+  const PiecewiseConstant2D distribution(f, nu, nv);
+  for (int row = 0; row < nv; ++row) {
+    std::vector<double> cdf(size_t(nu + 1), 0.0);
+    for (int i = 0; i < nu; ++i) cdf[size_t(i + 1)] = cdf[size_t(i)] + f[size_t(row * nu + i)];
+    for (double& c : cdf) c /= cdf[size_t(nu)];
+    // Row 0 holds about a third of the integral, row 1 the rest.
+    const float uy = row == 0 ? 0.125f : 0.9f;
+    float previousX = -1;
+    for (int s = 0; s < 16384; ++s) {
+      const float ux = float(s) / 16384.0f;
+      float pdf = 0;
+      const Vec2f p = distribution.sample({ux, uy}, &pdf);
+      ASSERT_EQ(int(p.y * nv), row);
+      ASSERT_GT(pdf, 0.0f) << "u " << ux << " sampled an empty cell";
+      ASSERT_GE(p.x, previousX) << "inversion is monotone in u";
+      previousX = p.x;
+      const int expected =
+          int(std::upper_bound(cdf.begin() + 1, cdf.end(), double(ux)) - cdf.begin()) - 1;
+      const double edge =
+          std::min(std::abs(ux - cdf[size_t(expected)]), std::abs(ux - cdf[size_t(expected + 1)]));
+      if (edge > 1e-5) {
+        ASSERT_EQ(int(p.x * nu), expected) << "u " << ux;
+      }
+    }
+  }
 }
 
 TEST(PiecewiseConstant2D, AllZeroFunctionIsUniform) {

@@ -1,6 +1,7 @@
 #include "renderer/sampling/distributions.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <string>
 
@@ -90,11 +91,28 @@ float buildCdf(const float* func, int n, float* cdf) {
   return float(sum / n);
 }
 
-// The interval i with cdf[i] <= u < cdf[i + 1] (skipping empty intervals), and the position
-// of u inside it as a fraction.
-int findInterval(const float* cdf, int n, float u, float* offset) {
-  const float* upper = std::upper_bound(cdf + 1, cdf + n + 1, u);
-  int i = std::clamp(int(upper - cdf) - 1, 0, n - 1);
+// Guide tables (Chen & Asau 1974): entry k of a cdf's guide is the interval that holds k / g,
+// so the interval of u lies between entries ⌊u g⌋ and ⌊u g⌋ + 1 and the binary search runs only
+// between them — the result of searching the whole cdf in a few probes of one or two cache lines
+// (the searches over 1k-wide environment maps were 5 % of an environment-lit render).
+int guideSize(int n) {
+  return int(std::bit_ceil(unsigned(std::max(1, n / 16))));  // a power of two: ⌊u g⌋ is exact
+}
+
+int intervalOf(const float* cdf, int n, float u, int first, int last) {
+  const float* upper = std::upper_bound(cdf + first + 1, cdf + last + 2, u);
+  return std::clamp(int(upper - cdf) - 1, 0, n - 1);
+}
+
+void buildGuide(const float* cdf, int n, int g, int* guide) {
+  for (int k = 0; k <= g; ++k) guide[k] = intervalOf(cdf, n, float(k) / float(g), 0, n - 1);
+}
+
+// The interval i with cdf[i] <= u < cdf[i + 1] (skipping empty intervals) for u in [0, 1], and
+// the position of u inside it as a fraction.
+int findInterval(const float* cdf, int n, const int* guide, int g, float u, float* offset) {
+  const int k = std::clamp(int(u * float(g)), 0, g - 1);
+  const int i = intervalOf(cdf, n, u, guide[k], guide[k + 1]);
   const float width = cdf[i + 1] - cdf[i];
   *offset = width > 0 ? std::clamp((u - cdf[i]) / width, 0.0f, 0x1.fffffep-1f) : 0.0f;
   return i;
@@ -128,12 +146,25 @@ PiecewiseConstant2D::PiecewiseConstant2D(std::span<const float> f, int nu, int n
                                        &conditionalCdf_[size_t(v) * size_t(nu + 1)]);
   marginalCdf_.resize(size_t(nv + 1));
   integral_ = buildCdf(rowIntegral_.data(), nv, marginalCdf_.data());
+
+  conditionalGuideSize_ = guideSize(nu);
+  marginalGuideSize_ = guideSize(nv);
+  const size_t rowGuide = size_t(conditionalGuideSize_ + 1);
+  conditionalGuide_.resize(size_t(nv) * rowGuide);
+  for (int v = 0; v < nv; ++v)
+    buildGuide(&conditionalCdf_[size_t(v) * size_t(nu + 1)], nu, conditionalGuideSize_,
+               &conditionalGuide_[size_t(v) * rowGuide]);
+  marginalGuide_.resize(size_t(marginalGuideSize_ + 1));
+  buildGuide(marginalCdf_.data(), nv, marginalGuideSize_, marginalGuide_.data());
 }
 
 Vec2f PiecewiseConstant2D::sample(Vec2f u, float* pdf) const {
   float dv, du;
-  const int v = findInterval(marginalCdf_.data(), nv_, u.y, &dv);
-  const int iu = findInterval(&conditionalCdf_[size_t(v) * size_t(nu_ + 1)], nu_, u.x, &du);
+  const int v =
+      findInterval(marginalCdf_.data(), nv_, marginalGuide_.data(), marginalGuideSize_, u.y, &dv);
+  const int iu = findInterval(&conditionalCdf_[size_t(v) * size_t(nu_ + 1)], nu_,
+                              &conditionalGuide_[size_t(v) * size_t(conditionalGuideSize_ + 1)],
+                              conditionalGuideSize_, u.x, &du);
   if (pdf) {
     *pdf =
         integral_ > 0 ? conditionalFunc_[size_t(v) * size_t(nu_) + size_t(iu)] / integral_ : 1.0f;

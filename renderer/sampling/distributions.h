@@ -41,6 +41,9 @@ class PiecewiseConstant2D {
   std::vector<float> conditionalCdf_;  // nv rows of nu + 1
   std::vector<float> conditionalFunc_, rowIntegral_, marginalCdf_;
   float integral_ = 0;
+  // Guide tables of the cdfs (see distributions.cpp): nv rows of g + 1, and g + 1.
+  int conditionalGuideSize_ = 1, marginalGuideSize_ = 1;
+  std::vector<int> conditionalGuide_, marginalGuide_;
 };
 
 }  // namespace chorus::render

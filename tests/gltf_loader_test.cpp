@@ -453,6 +453,23 @@ TEST_F(GltfLoaderErrors, MissingTextureImageThatIsUsed) {
   expectError(dir_ / "s.gltf", "gone.png");
 }
 
+TEST_F(GltfLoaderErrors, UndecodableImagesNameTheFirstInFileOrder) {
+  // Images decode in parallel; the error must still be the first bad one, on every run.
+  GltfBuilder b;
+  for (const char* name : {"first-bad.png", "second-bad.png"}) {
+    std::ofstream(dir_ / name) << "not a PNG at all";
+    b.root()["images"].push_back({{"uri", name}});
+    b.root()["textures"].push_back({{"source", b.root()["images"].size() - 1}});
+    json m = {{"pbrMetallicRoughness",
+               {{"baseColorTexture", {{"index", b.root()["textures"].size() - 1}}}}}};
+    b.addTriangleMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2}, b.addMaterial(m), {},
+                      {{0, 0}, {1, 0}, {0, 1}});
+  }
+  b.writeGltf(dir_ / "s.gltf");
+  for (int run = 0; run < 5; ++run)
+    expectError(dir_ / "s.gltf", "cannot decode image 'first-bad.png'");
+}
+
 TEST_F(GltfLoaderErrors, UnsupportedRequiredExtension) {
   GltfBuilder b;
   b.addNode({{"mesh", unitTriangleMesh(b)}});

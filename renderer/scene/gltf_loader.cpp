@@ -105,6 +105,7 @@ class SceneBuilder {
         if (!isChild[i]) roots.push_back(int(i));
     }
     for (int root : roots) visit(root, Transform(), 0);
+    materials_.decodeImages();
     if (skippedPrimitives_ > 0)
       out_.warnings.push_back("skipped " + std::to_string(skippedPrimitives_) +
                               " point/line primitive(s): chorus renders triangles only");

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/parallel_for.h>
+
 #include "denoise/util/error.h"
 #include "renderer/scene/texture.h"
 
@@ -204,9 +206,26 @@ int MaterialReader::image(int gltfIndex) {
     throw Error("image " + std::to_string(gltfIndex) + " has no data");
   }
   const int index = int(out_.images.size());
-  out_.images.push_back(decodeImage(gi.image, name));
+  out_.images.push_back({});
+  out_.images.back().name = name;
+  pendingImages_.push_back(&gi);
   images_[gltfIndex] = index;
   return index;
+}
+
+void MaterialReader::decodeImages() {
+  std::vector<std::string> errors(pendingImages_.size());
+  tbb::parallel_for(size_t(0), pendingImages_.size(), [&](size_t i) {
+    try {
+      out_.images[i] = decodeImage(pendingImages_[i]->image, out_.images[i].name);
+    } catch (const Error& e) {
+      errors[i] = e.what();
+    }
+  });
+  pendingImages_.clear();
+  // The first bad image in the file's order, whichever thread saw it first.
+  for (const std::string& error : errors)
+    if (!error.empty()) throw Error(error);
 }
 
 }  // namespace chorus::render::gltf

@@ -1,7 +1,8 @@
 #pragma once
 // glTF materials, textures and images → MaterialDesc / TextureDesc / ImageDesc. Internal to the
 // glTF loader. Only what the scene uses is built: a material is converted when the first
-// primitive refers to it, and an image is decoded when the first used material refers to it.
+// primitive refers to it, and only the images used materials refer to are decoded (all at once, in
+// parallel, by decodeImages()).
 #include <tiny_gltf.h>
 
 #include <map>
@@ -19,6 +20,9 @@ class MaterialReader {
 
   // Index into out.materials for glTF material `gltfIndex` (−1: the glTF default material).
   int materialIndex(int gltfIndex);
+  // Decodes the images the converted materials use, in parallel (a textured model's PNGs were
+  // most of its load time); until then out.images holds only their names. Call once, last.
+  void decodeImages();
 
  private:
   MaterialDesc convert(const tinygltf::Material& m, int gltfIndex);
@@ -30,6 +34,7 @@ class MaterialReader {
   const tinygltf::Model& model_;
   SceneDesc& out_;
   std::map<int, int> materials_, textures_, images_;
+  std::vector<const tinygltf::Image*> pendingImages_;  // the source of each out.images entry
 };
 
 }  // namespace chorus::render::gltf

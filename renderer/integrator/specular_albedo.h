@@ -5,10 +5,10 @@
 // BSDF uses it to hand the diffuse base exactly the energy the specular layer leaves
 // (albedo scaling, Kelemen & Szirmay-Kalos 2001; Kulla & Conty 2017).
 //
-// The terms come from a table over (μ, roughness) integrated numerically once per process
-// (deterministic), interpolated bilinearly. The cosine-weighted average 2 ∫ E(μ) μ dμ is the
-// exact integral of that same interpolant, so the albedo scaling conserves energy exactly with
-// respect to the table.
+// The terms come from a table over (μ, roughness) integrated numerically (deterministic; each
+// roughness row once per process, when first needed), interpolated bilinearly. The cosine-weighted
+// average 2 ∫ E(μ) μ dμ is the exact integral of that same interpolant, so the albedo scaling
+// conserves energy exactly with respect to the table.
 namespace chorus::render {
 
 struct SpecularAlbedoTerms {

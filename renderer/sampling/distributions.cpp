@@ -104,13 +104,16 @@ int intervalOf(const float* cdf, int n, float u, int first, int last) {
   return std::clamp(int(upper - cdf) - 1, 0, n - 1);
 }
 
-void buildGuide(const float* cdf, int n, int g, int* guide) {
+// The guideSize(n) + 1 entries of a cdf's guide.
+void buildGuide(const float* cdf, int n, int* guide) {
+  const int g = guideSize(n);
   for (int k = 0; k <= g; ++k) guide[k] = intervalOf(cdf, n, float(k) / float(g), 0, n - 1);
 }
 
 // The interval i with cdf[i] <= u < cdf[i + 1] (skipping empty intervals) for u in [0, 1], and
 // the position of u inside it as a fraction.
-int findInterval(const float* cdf, int n, const int* guide, int g, float u, float* offset) {
+int findInterval(const float* cdf, int n, const int* guide, float u, float* offset) {
+  const int g = guideSize(n);
   const int k = std::clamp(int(u * float(g)), 0, g - 1);
   const int i = intervalOf(cdf, n, u, guide[k], guide[k + 1]);
   const float width = cdf[i + 1] - cdf[i];
@@ -147,24 +150,21 @@ PiecewiseConstant2D::PiecewiseConstant2D(std::span<const float> f, int nu, int n
   marginalCdf_.resize(size_t(nv + 1));
   integral_ = buildCdf(rowIntegral_.data(), nv, marginalCdf_.data());
 
-  conditionalGuideSize_ = guideSize(nu);
-  marginalGuideSize_ = guideSize(nv);
-  const size_t rowGuide = size_t(conditionalGuideSize_ + 1);
+  const size_t rowGuide = size_t(guideSize(nu)) + 1;
   conditionalGuide_.resize(size_t(nv) * rowGuide);
   for (int v = 0; v < nv; ++v)
-    buildGuide(&conditionalCdf_[size_t(v) * size_t(nu + 1)], nu, conditionalGuideSize_,
+    buildGuide(&conditionalCdf_[size_t(v) * size_t(nu + 1)], nu,
                &conditionalGuide_[size_t(v) * rowGuide]);
-  marginalGuide_.resize(size_t(marginalGuideSize_ + 1));
-  buildGuide(marginalCdf_.data(), nv, marginalGuideSize_, marginalGuide_.data());
+  marginalGuide_.resize(size_t(guideSize(nv)) + 1);
+  buildGuide(marginalCdf_.data(), nv, marginalGuide_.data());
 }
 
 Vec2f PiecewiseConstant2D::sample(Vec2f u, float* pdf) const {
   float dv, du;
-  const int v =
-      findInterval(marginalCdf_.data(), nv_, marginalGuide_.data(), marginalGuideSize_, u.y, &dv);
-  const int iu = findInterval(&conditionalCdf_[size_t(v) * size_t(nu_ + 1)], nu_,
-                              &conditionalGuide_[size_t(v) * size_t(conditionalGuideSize_ + 1)],
-                              conditionalGuideSize_, u.x, &du);
+  const int v = findInterval(marginalCdf_.data(), nv_, marginalGuide_.data(), u.y, &dv);
+  const int iu =
+      findInterval(&conditionalCdf_[size_t(v) * size_t(nu_ + 1)], nu_,
+                   &conditionalGuide_[size_t(v) * (size_t(guideSize(nu_)) + 1)], u.x, &du);
   if (pdf) {
     *pdf =
         integral_ > 0 ? conditionalFunc_[size_t(v) * size_t(nu_) + size_t(iu)] / integral_ : 1.0f;

@@ -41,8 +41,8 @@ class PiecewiseConstant2D {
   std::vector<float> conditionalCdf_;  // nv rows of nu + 1
   std::vector<float> conditionalFunc_, rowIntegral_, marginalCdf_;
   float integral_ = 0;
-  // Guide tables of the cdfs (see distributions.cpp): nv rows of g + 1, and g + 1.
-  int conditionalGuideSize_ = 1, marginalGuideSize_ = 1;
+  // Guide tables of the cdfs (see distributions.cpp): nv rows of guideSize(nu) + 1 entries, and
+  // guideSize(nv) + 1.
   std::vector<int> conditionalGuide_, marginalGuide_;
 };
 

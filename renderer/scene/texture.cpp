@@ -85,10 +85,8 @@ ImageDesc decodeImage(std::span<const uint8_t> bytes, const std::string& name) {
 
 std::array<float, 4> Texture::texel(int ix, int iy, ColorEncoding encoding) const {
   const uint8_t* p = image_->rgba.data() + (size_t(iy) * size_t(image_->width) + size_t(ix)) * 4;
-  if (encoding == ColorEncoding::Srgb) {
-    const std::array<float, 256>& table = srgbTable();
-    return {table[p[0]], table[p[1]], table[p[2]], p[3] / 255.0f};
-  }
+  if (encoding == ColorEncoding::Srgb)
+    return {srgbByteToLinear(p[0]), srgbByteToLinear(p[1]), srgbByteToLinear(p[2]), p[3] / 255.0f};
   return {p[0] / 255.0f, p[1] / 255.0f, p[2] / 255.0f, p[3] / 255.0f};
 }
 

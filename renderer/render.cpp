@@ -12,6 +12,7 @@
 #include "denoise/util/stopwatch.h"
 #include "renderer/integrator/camera.h"
 #include "renderer/integrator/film.h"
+#include "renderer/integrator/lane_tracer.h"
 #include "renderer/integrator/lights.h"
 #include "renderer/integrator/path_tracer.h"
 #include "renderer/sampling/sampler.h"
@@ -49,8 +50,10 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
       selectCamera(scene, options.camera, float(resolution.width) / float(resolution.height)),
       resolution);
   const LightSet lights(scene);
-  const PathTracer tracer(scene, lights,
-                          PathTracerSettings{options.maxDepth, options.rouletteStartDepth});
+  const PathTracerSettings settings{options.maxDepth, options.rouletteStartDepth};
+  const PathTracer tracer(scene, lights, settings);
+  const std::optional<LaneTracer> laneTracer =
+      options.lanes ? LaneTracer::create(scene, lights, settings) : std::nullopt;
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   Film film =
       arena.execute([&] { return Film(resolution.width, resolution.height, options.splits); });
@@ -69,7 +72,10 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
     Sampler sampler(options.seed);
     PathTracer::RayCounts tileRays;
     uint64_t tileDropped = 0;
-    for (int y = y0; y < y1; ++y) {
+    if (laneTracer)
+      laneTracer->renderTile({x0, y0, x1, y1}, {options.spp, options.splits, options.seed}, camera,
+                             film, tileRays, tileDropped);
+    for (int y = y0; y < y1 && !laneTracer; ++y) {
       for (int x = x0; x < x1; ++x) {
         PixelAccumulator pixel;
         for (int i = 0; i < options.spp; ++i) {

@@ -31,6 +31,9 @@ struct RenderOptions {
   // with renderers that trace every path to full length).
   int rouletteStartDepth = 3;
   int camera = 0;  // index into the scene's cameras (0 with none: frame the bounds)
+  // Trace scenes of plain Lambertian surfaces and area lights four paths at a time
+  // (LaneTracer, bit-identical images); false: always the general one-path tracer.
+  bool lanes = true;
 };
 
 struct RenderStats {

@@ -17,9 +17,6 @@ constexpr float kMinBaseEnergy = 1e-4f;
 // Rough lobes whose weight estimate at the macro normal is 0 (black metal seen head-on, glass
 // at total internal reflection) can still scatter through tilted microfacets: keep sampling them.
 constexpr float kMinRoughLobeWeight = 0.05f;
-// Directions closer to the tangent plane than this scatter nothing: the microfacet terms'
-// 1 / (cos θo cos θi) would underflow to 0 / 0.
-constexpr float kMinCosine = 1e-7f;
 
 float clamp01(float v) {
   return v >= 0 ? std::min(v, 1.0f) : 0.0f;  // also maps NaN to 0
@@ -31,7 +28,7 @@ Vec3f mirrorZ(Vec3f v) {
   return {v.x, v.y, -v.z};
 }
 bool grazingSafe(Vec3f w) {
-  return std::abs(w.z) >= kMinCosine && isFinite(w);
+  return std::abs(w.z) >= kMinBsdfCosine && isFinite(w);
 }
 bool finiteInputs(Vec3f v, float uLobe, Vec2f u) {
   return isFinite(v) && std::isfinite(uLobe) && std::isfinite(u.x) && std::isfinite(u.y);

@@ -36,6 +36,9 @@
 namespace chorus::render {
 
 inline constexpr float kDeltaRoughness = 1e-3f;  // perceptual roughness
+// Directions closer to the tangent plane than this scatter nothing: the microfacet terms'
+// 1 / (cos θo cos θi) would underflow to 0 / 0.
+inline constexpr float kMinBsdfCosine = 1e-7f;
 
 // The material at one surface point, after texture lookups (all colours linear).
 struct MaterialPoint {
@@ -82,6 +85,13 @@ class Bsdf {
   // Transmits light at all (so the integrator keeps transmission paths and shadow rays
   // pass thin-walled surfaces only where this is true).
   bool hasTransmission() const { return transmits_; }
+  // Only a non-black Lambertian lobe: f = baseColor / π, sampled by the cosine.
+  bool isPlainLambertian() const { return lambertian_; }
+  // Black and without any specular lobe (e.g. the body of a light): f = 0 everywhere.
+  bool scattersNothing() const {
+    return m_.metallic == 0 && m_.specular == 0 && m_.transmission == 0 &&
+           m_.baseColor.maxComponent() == 0;
+  }
   // The value recorded in the albedo feature buffer: the material's overall reflectance colour
   // (baseColor for diffuse and metals, weighted by the lobe mix).
   Rgb albedo() const { return albedo_; }

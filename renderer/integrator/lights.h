@@ -42,12 +42,6 @@ class LightSet {
 
   size_t areaLightCount() const { return areaLights_.size(); }
 
- private:
-  enum class Kind : uint8_t { Area, Punctual, Environment };
-  struct LightRef {
-    Kind kind;
-    uint32_t index;  // into areaLights_ or the scene's punctual lights
-  };
   struct AreaLight {
     uint32_t geomID = 0, primID = 0;
     float area = 0;
@@ -58,6 +52,23 @@ class LightSet {
     bool doubleSided = false;
     Vec3f normal;
     Rgb Le;
+  };
+
+  // True when there are lights and every one is a uniform area light: no punctual light, no
+  // environment, no textured emission (the case LaneTracer handles).
+  bool onlyUniformAreaLights() const;
+  // The light sample() picks with uChoice, when onlyUniformAreaLights(); null where its
+  // probability is 0 (sample() returns nothing then).
+  const AreaLight* pickAreaLight(float uChoice, float* pmf) const {
+    const int index = choice_.sample(uChoice, pmf);
+    return *pmf > 0 ? &areaLights_[size_t(index)] : nullptr;
+  }
+
+ private:
+  enum class Kind : uint8_t { Area, Punctual, Environment };
+  struct LightRef {
+    Kind kind;
+    uint32_t index;  // into areaLights_ or the scene's punctual lights
   };
 
   // Fill `s` (default-constructed) and return true, or return false when no sample results.

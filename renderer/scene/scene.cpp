@@ -291,6 +291,58 @@ bool Scene::occluded(const Vec3f& origin, const Vec3f& direction, float tMax) co
   return ray.tfar < 0;  // Embree sets tfar to −∞ on a hit
 }
 
+namespace {
+
+template <typename EmbreeRays>
+void fillRays(const RayPacket4& rays, EmbreeRays* r) {
+  for (int i = 0; i < 4; ++i) {
+    r->org_x[i] = rays.ox[i];
+    r->org_y[i] = rays.oy[i];
+    r->org_z[i] = rays.oz[i];
+    r->dir_x[i] = rays.dx[i];
+    r->dir_y[i] = rays.dy[i];
+    r->dir_z[i] = rays.dz[i];
+    r->tnear[i] = 0.0f;
+    r->tfar[i] = rays.tMax[i];
+    r->time[i] = 0.0f;
+    r->mask[i] = ~0u;
+    r->id[i] = 0;
+    r->flags[i] = 0;
+  }
+}
+
+}  // namespace
+
+void Scene::intersect4(const int32_t active[4], const RayPacket4& rays, HitPacket4* hits) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  alignas(16) RTCRayHit4 rh;
+  fillRays(rays, &rh.ray);
+  for (int i = 0; i < 4; ++i) {
+    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  rtcIntersect4(active, embree_->scene, &context, &rh);
+  for (int i = 0; i < 4; ++i) {
+    if (!active[i]) continue;
+    hits->geomID[i] =
+        rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID ? HitPacket4::kNoHit : rh.hit.geomID[i];
+    hits->t[i] = rh.ray.tfar[i];
+    hits->primID[i] = rh.hit.primID[i];
+    hits->u[i] = rh.hit.u[i];
+    hits->v[i] = rh.hit.v[i];
+  }
+}
+
+void Scene::occluded4(const int32_t active[4], const RayPacket4& rays, int32_t blocked[4]) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  alignas(16) RTCRay4 r;
+  fillRays(rays, &r);
+  rtcOccluded4(active, embree_->scene, &context, &r);
+  for (int i = 0; i < 4; ++i) blocked[i] = active[i] && r.tfar[i] < 0 ? -1 : 0;
+}
+
 SurfaceInteraction Scene::interaction(const Hit& hit, const Vec3f& rayDirection) const {
   const SceneMesh& sm = data_->meshes[hit.geomID];
   const MeshDesc& mesh = sm.mesh;

@@ -29,6 +29,17 @@ struct Hit {
   float u = 0, v = 0;  // barycentrics of vertices 1 and 2
 };
 
+// Four rays for Embree's 4-wide packet queries, one per lane (structure of arrays).
+struct RayPacket4 {
+  alignas(16) float ox[4], oy[4], oz[4], dx[4], dy[4], dz[4], tMax[4];
+};
+// The closest hits of a RayPacket4; geomID[i] is kNoHit where lane i hit nothing.
+struct HitPacket4 {
+  static constexpr uint32_t kNoHit = ~0u;
+  alignas(16) float t[4], u[4], v[4];
+  alignas(16) uint32_t geomID[4], primID[4];
+};
+
 // Everything the integrator needs about a hit point.
 struct SurfaceInteraction {
   Vec3f position;         // from the barycentrics (more accurate than origin + t · direction)
@@ -57,7 +68,7 @@ struct SceneMesh {
     bool valid = false;
   };
   std::vector<FlatFrame> flatFrames;  // by primID
-  int firstAreaLight = -1;  // area light index of primID 0 when the material emits
+  int firstAreaLight = -1;            // area light index of primID 0 when the material emits
   bool alphaTested = false;
 };
 
@@ -94,6 +105,10 @@ class Scene {
   bool intersect(const Ray& ray, Hit* hit, bool coherent = false) const;
   // Whether anything blocks the segment (0, tMax) along direction.
   bool occluded(const Vec3f& origin, const Vec3f& direction, float tMax) const;
+  // The same queries for the lanes i with active[i] = −1 (others are left alone): the hits
+  // equal intersect()'s; blocked[i] = −1 where occluded() would return true, else 0.
+  void intersect4(const int32_t active[4], const RayPacket4& rays, HitPacket4* hits) const;
+  void occluded4(const int32_t active[4], const RayPacket4& rays, int32_t blocked[4]) const;
 
   SurfaceInteraction interaction(const Hit& hit, const Vec3f& rayDirection) const;
   MaterialPoint materialPoint(const SurfaceInteraction& si) const;

@@ -273,7 +273,11 @@ int main(int argc, char** argv) {
       RenderStats stats;
       Timing time;
     };
-    std::optional<Measured> roulette, noRoulette;
+    // The same two renders with the general one-path tracer, for the lane tracer's gain (it
+    // takes this scene: plain Lambertian surfaces and area lights).
+    RenderOptions onePath = options, onePathFullDepth = fullDepth;
+    onePath.lanes = onePathFullDepth.lanes = false;
+    std::optional<Measured> roulette, noRoulette, onePathRoulette, onePathNoRoulette;
     std::optional<PeerRun> peerRun;
     const auto keepFaster = [&](std::optional<Measured>& best, const RenderOptions& o) {
       RenderResult result;
@@ -284,6 +288,8 @@ int main(int argc, char** argv) {
     for (int round = 0; round < repeat; ++round) {
       keepFaster(roulette, options);
       keepFaster(noRoulette, fullDepth);
+      keepFaster(onePathRoulette, onePath);
+      keepFaster(onePathNoRoulette, onePathFullDepth);
       if (withPeer) {
         PeerRun run = runPeer(size, spp, threads);
         if (run.ok && (!peerRun || run.time.wall < peerRun->time.wall)) peerRun = run;
@@ -291,6 +297,10 @@ int main(int argc, char** argv) {
     }
     reportRender("chorus (Russian roulette, depth 8)", roulette->stats, roulette->time);
     reportRender("chorus (no roulette, depth 8)", noRoulette->stats, noRoulette->time);
+    reportRender("chorus one-path tracer (roulette)", onePathRoulette->stats,
+                 onePathRoulette->time);
+    reportRender("chorus one-path tracer (no roulette)", onePathNoRoulette->stats,
+                 onePathNoRoulette->time);
     double peerSamplesPerSecond = 0;
     if (peerRun)
       peerSamplesPerSecond = reportPeer(*peerRun, size, spp, threads);

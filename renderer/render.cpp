@@ -121,6 +121,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
   s.shadowRays = shadowRays;
   s.nanSamplesDropped = dropped;
   s.triangles = scene.data().triangleCount;
+  s.lanes = laneTracer.has_value();
   return result;
 }
 

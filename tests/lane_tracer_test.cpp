@@ -48,6 +48,8 @@ double expectLanesEqualScalar(const Scene& scene, RenderOptions o) {
                             lanes.buffers.sub(k).get(q).varianceOfMean))
           << quantityName(q) << " variance, sub-buffer " << k;
     }
+  EXPECT_FALSE(scalar.stats.lanes);
+  EXPECT_TRUE(lanes.stats.lanes);
   EXPECT_EQ(scalar.stats.rays, lanes.stats.rays);
   EXPECT_EQ(scalar.stats.shadowRays, lanes.stats.shadowRays);
   EXPECT_EQ(scalar.stats.nanSamplesDropped, lanes.stats.nanSamplesDropped);

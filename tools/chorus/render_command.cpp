@@ -77,6 +77,7 @@ nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderStats& s,
   j["rays_per_second"] = s.raysPerSecond();
   j["triangles"] = s.triangles;
   j["nan_samples_dropped"] = s.nanSamplesDropped;
+  j["tracer"] = s.lanes ? "lanes" : "one-path";
   j["warnings"] = loaded.warnings;
   j["chorus_version"] = CHORUS_VERSION;
   return j;

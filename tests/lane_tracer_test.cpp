@@ -2,6 +2,7 @@
 // same buffers bit for bit on every scene it takes, and the scenes it must leave to the general
 // tracer.
 #include <gtest/gtest.h>
+#include <stb_image_write.h>
 
 #include <algorithm>
 
@@ -79,14 +80,18 @@ TEST(LaneTracer, CornellBoxBitIdenticalToTheScalarTracer) {
   expectLanesEqualScalar(scene, shallow);
 }
 
-// Double-sided and one-sided emitters seen from both sides, two light sources of different
-// power, walls seen from behind and rays escaping to the (black) background.
-Scene openRoom(const test::TempDir& dir) {
+// Every kind of light and surface the lane tracer takes, in one open room: one- and two-sided
+// emitters, a black emitter body, a smooth sphere (shading normals from the vertices), walls
+// seen from behind, point and spot lights, and an environment (constant or a map) that escaping
+// rays see and next-event estimation samples.
+Scene openRoom(const test::TempDir& dir, EnvironmentDesc environment) {
   GltfBuilder b;
   b.addQuad({-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3},
             b.addMaterial(test::lambertianMaterial(0.7f, 0.6f, 0.5f)));
   b.addQuad({-1, 0, -1}, {-1, 1.5f, -1}, {-1, 1.5f, 1}, {-1, 0, 1},  // faces −x, seen from behind
             b.addMaterial(test::lambertianMaterial(0.2f, 0.8f, 0.3f)));
+  b.addSphere({0.2f, 0.5f, 0.3f}, 0.45f, b.addMaterial(test::lambertianMaterial(0.9f, 0.9f, 0.9f)),
+              24);
   json oneSided = test::lambertianMaterial(0, 0, 0);
   oneSided["emissiveFactor"] = {4, 3, 2};
   b.addQuad({-0.5f, 2, -0.5f}, {0.5f, 2, -0.5f}, {0.5f, 2, 0.5f}, {-0.5f, 2, 0.5f},
@@ -96,56 +101,58 @@ Scene openRoom(const test::TempDir& dir) {
   twoSided["doubleSided"] = true;
   b.addQuad({1, 0.2f, -0.5f}, {1, 0.2f, 0.5f}, {1, 1.2f, 0.5f}, {1, 1.2f, -0.5f},
             b.addMaterial(twoSided));
+  const int point = b.addPunctualLight({{"type", "point"}, {"intensity", 3}});
+  b.addNode({{"translation", {-0.5, 1, 1}},
+             {"extensions", {{"KHR_lights_punctual", {{"light", point}}}}}});
+  const int spot =
+      b.addPunctualLight({{"type", "spot"}, {"intensity", 6}, {"spot", {{"outerConeAngle", 0.6}}}});
+  b.addNode({{"translation", {0, 1.8, 0}},
+             {"rotation", {-0.7071, 0, 0, 0.7071}},
+             {"extensions", {{"KHR_lights_punctual", {{"light", spot}}}}}});
   const int cam =
       b.addCamera({{"type", "perspective"}, {"perspective", {{"yfov", 1.2}, {"znear", 0.01}}}});
   b.addNode({{"camera", cam}, {"translation", {0, 1.2, 3}}, {"rotation", {-0.17, 0, 0, 0.985}}});
   b.writeGltf(dir / "open.gltf");
-  return loadScene(dir / "open.gltf");
+  return loadScene(dir / "open.gltf", environment);
 }
 
-TEST(LaneTracer, OpenRoomWithTwoSidedEmittersBitIdentical) {
+TEST(LaneTracer, OpenRoomWithEveryKindOfLightBitIdentical) {
   test::TempDir dir;
-  const Scene scene = openRoom(dir);
-  ASSERT_TRUE(LaneTracer::create(scene, LightSet(scene), PathTracerSettings{}).has_value());
-  EXPECT_GT(expectLanesEqualScalar(scene, options(33, 21, 5, 1)), 0.01);
+  const Scene lit = openRoom(dir, EnvironmentDesc{});
+  EXPECT_GT(expectLanesEqualScalar(lit, options(33, 21, 5, 1)), 0.01);
+  const Scene sky = openRoom(dir, EnvironmentDesc::constant(Rgb(0.3f, 0.4f, 0.6f)));
+  expectLanesEqualScalar(sky, options(17, 15, 4, 2));
+  // An equirectangular map with a bright band, importance-sampled.
+  const int w = 16, h = 8;
+  std::vector<float> texels(size_t(w * h * 3));
+  for (size_t i = 0; i < texels.size(); ++i) texels[i] = (i / 3) % size_t(w) < 4 ? 5.0f : 0.2f;
+  const std::filesystem::path hdr = dir / "env.hdr";
+  ASSERT_NE(stbi_write_hdr(hdr.c_str(), w, h, 3, texels.data()), 0);
+  expectLanesEqualScalar(openRoom(dir, environmentFromFile(hdr, 30.0f, 1.0f)),
+                         options(17, 15, 4, 4));
 }
 
-TEST(LaneTracer, LeavesOtherScenesToTheGeneralTracer) {
+TEST(LaneTracer, LeavesOtherMaterialsToTheGeneralTracer) {
   test::TempDir dir;
-  const auto accepts = [](const Scene& scene) {
-    return LaneTracer::create(scene, LightSet(scene), PathTracerSettings{}).has_value();
-  };
-  const auto room = [&](json floorMaterial, bool pointLight, bool sphere) {
+  const auto accepts = [&](json floorMaterial) {
     GltfBuilder b;
     b.addQuad({-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}, b.addMaterial(floorMaterial));
-    json emitter = test::lambertianMaterial(0, 0, 0);
-    emitter["emissiveFactor"] = {1, 1, 1};
-    b.addQuad({-0.5f, 2, -0.5f}, {0.5f, 2, -0.5f}, {0.5f, 2, 0.5f}, {-0.5f, 2, 0.5f},
-              b.addMaterial(emitter));
-    if (sphere)  // smooth vertex normals: the shading normal varies over each triangle
-      b.addSphere({0, 0.5f, 0}, 0.5f, b.addMaterial(test::lambertianMaterial(0.5f, 0.5f, 0.5f)), 8);
-    if (pointLight) {
-      const int light = b.addPunctualLight({{"type", "point"}, {"intensity", 5}});
-      b.addNode({{"translation", {0, 1, 0}},
-                 {"extensions", {{"KHR_lights_punctual", {{"light", light}}}}}});
-    }
-    b.writeGltf(dir / "room.gltf");
-    return loadScene(dir / "room.gltf");
+    b.writeGltf(dir / "floor.gltf");
+    const Scene scene = loadScene(dir / "floor.gltf");
+    return LaneTracer::create(scene, LightSet(scene), PathTracerSettings{}).has_value();
   };
-  const json lambertian = test::lambertianMaterial(0.5f, 0.5f, 0.5f);
-  EXPECT_TRUE(accepts(room(lambertian, false, false)));
-  EXPECT_FALSE(accepts(room(lambertian, true, false)));
-  EXPECT_FALSE(accepts(room(lambertian, false, true)));
-  json metal = {{"pbrMetallicRoughness", {{"metallicFactor", 1.0}, {"roughnessFactor", 0.3}}}};
-  EXPECT_FALSE(accepts(room(metal, false, false)));
-  json layered = {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}};  // default specular layer
-  EXPECT_FALSE(accepts(room(layered, false, false)));
-  // An environment that emits.
-  GltfBuilder b;
-  b.addQuad({-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}, b.addMaterial(lambertian));
-  b.writeGltf(dir / "unlit.gltf");
-  EXPECT_FALSE(accepts(loadScene(dir / "unlit.gltf")));  // the default white environment
-  EXPECT_FALSE(accepts(loadScene(dir / "unlit.gltf", EnvironmentDesc::constant(Rgb(0.5f)))));
+  EXPECT_TRUE(accepts(test::lambertianMaterial(0.5f, 0.5f, 0.5f)));
+  EXPECT_FALSE(
+      accepts({{"pbrMetallicRoughness", {{"metallicFactor", 1.0}, {"roughnessFactor", 0.3}}}}));
+  // The default KHR_materials_specular layer over the diffuse base.
+  EXPECT_FALSE(accepts({{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}}));
+  json glass = test::lambertianMaterial(0.5f, 0.5f, 0.5f);
+  glass["extensions"]["KHR_materials_transmission"] = {{"transmissionFactor", 1.0}};
+  EXPECT_FALSE(accepts(glass));
+  json masked = test::lambertianMaterial(0.5f, 0.5f, 0.5f);
+  masked["alphaMode"] = "MASK";
+  masked["pbrMetallicRoughness"]["baseColorFactor"] = {0.5, 0.5, 0.5, 0.2};
+  EXPECT_FALSE(accepts(masked));
 }
 
 }  // namespace

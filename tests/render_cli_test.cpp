@@ -62,7 +62,7 @@ TEST(RenderCli, WritesExrPngAndStats) {
   EXPECT_EQ(stats["samples"], 12 * 8 * 8);
   EXPECT_EQ(stats["triangles"], 2);
   EXPECT_EQ(stats["nan_samples_dropped"], 0);
-  EXPECT_EQ(stats["tracer"], "one-path");  // a point light: not a scene for the lane tracer
+  EXPECT_EQ(stats["tracer"], "lanes");  // a Lambertian quad: the lane tracer's kind of scene
   // A camera ray that hits the quad sends one shadow ray to the light in front of it and one
   // bounce ray, which escapes (nothing else is in the scene); one that misses traces nothing else.
   const auto rays = stats["rays"].get<uint64_t>(),

@@ -129,19 +129,393 @@ struct LaneArray {
   explicit LaneArray(Mask m) { std::memcpy(value, &m, sizeof value); }
 };
 
+RayPacket4 packet(const L::Vec3& origin, const L::Vec3& direction, Float tMax) {
+  RayPacket4 r;
+  for (int i = 0; i < L::kWidth; ++i) {
+    r.ox[i] = origin.x[i], r.oy[i] = origin.y[i], r.oz[i] = origin.z[i];
+    r.dx[i] = direction.x[i], r.dy[i] = direction.y[i], r.dz[i] = direction.z[i];
+    r.tMax[i] = tMax[i];
+  }
+  return r;
+}
+
+// What PathTracer::trace knows at a hit point, for the lanes in `hit`.
+struct Vertex {
+  Mask hit{};
+  L::Vec3 position{}, positionError{};
+  L::Vec3 geometricNormal{};  // as Scene::interaction gives it (for emission and MIS)
+  L::Vec3 ng{};               // turned to the side the ray arrives on
+  L::Vec3 wo{}, woLocal{};
+  LaneFrame frame{};
+  L::Vec3 albedo{}, f{};  // Bsdf::albedo() and the Lambertian f (0 for black surfaces)
+  std::array<SurfaceInteraction, L::kWidth> interaction;  // lanes on smooth triangles only
+};
+
+// A vertex's sampler draws (Sampler::BounceDraws), a lane each.
+struct Draws {
+  Float lobe{}, directionX{}, directionY{}, light{}, lightX{}, lightY{}, roulette{};
+};
+
+// LightSample in lanes.
+struct LightLanes {
+  Mask sampled{}, delta{}, infinite{};
+  L::Vec3 wi{}, Li{}, pLight{}, pLightError{}, nLight{};
+  Float pdf{};
+};
+
 }  // namespace
+
+// The four lanes of one tile: their pixels, samplers and paths.
+class LaneTileRenderer {
+ public:
+  LaneTileRenderer(const LaneTracer& tracer, const LaneTracer::Tile& tile,
+                   const LaneTracer::Sampling& sampling, const Camera& camera, Film& film,
+                   PathTracer::RayCounts& rays, uint64_t& dropped)
+      : t_(tracer),
+        tile_(tile),
+        sampling_(sampling),
+        camera_(camera),
+        film_(film),
+        rays_(rays),
+        dropped_(dropped),
+        samplers_{Sampler(sampling.seed), Sampler(sampling.seed), Sampler(sampling.seed),
+                  Sampler(sampling.seed)} {}
+
+  void run() {
+    for (int i = 0; i < L::kWidth; ++i) takePixel(i);
+    while (L::any(alive_)) step();
+  }
+
+ private:
+  // Per lane: its pixel, the sample being traced and the pixel's accumulators.
+  struct Lane {
+    int x = 0, y = 0, sample = 0;
+    PixelAccumulator pixel;
+  };
+
+  void startSample(int i) {
+    Lane& l = lanes_[size_t(i)];
+    Sampler& sampler = samplers_[size_t(i)];
+    sampler.startPixelSample(l.x, l.y, uint32_t(l.sample / sampling_.splits),
+                             l.sample % sampling_.splits);
+    const Vec2f offset = sampler.getPixel2D();
+    p_.start(i, camera_.generateRay({float(l.x) + offset.x, float(l.y) + offset.y}));
+  }
+
+  void takePixel(int i) {
+    const int width = tile_.x1 - tile_.x0;
+    if (nextPixel_ == width * (tile_.y1 - tile_.y0)) {
+      alive_[i] = 0;
+      return;
+    }
+    Lane& l = lanes_[size_t(i)];
+    l.x = tile_.x0 + nextPixel_ % width;
+    l.y = tile_.y0 + nextPixel_ / width;
+    ++nextPixel_;
+    l.sample = 0;
+    l.pixel = PixelAccumulator{};
+    alive_[i] = -1;
+    startSample(i);
+  }
+
+  // The path of lane i has ended: accumulate it, then start the next sample or pixel.
+  void finishPath(int i) {
+    Lane& l = lanes_[size_t(i)];
+    if (!l.pixel.add(l.sample % sampling_.splits, p_.sample(i))) ++dropped_;
+    if (++l.sample < sampling_.spp) return startSample(i);
+    film_.store(l.x, l.y, l.pixel);
+    takePixel(i);
+  }
+
+  // One vertex of every live path.
+  void step() {
+    std::array<uint32_t, L::kWidth> bounceDimensions{};
+    for (int i = 0; i < L::kWidth; ++i)
+      if (alive_[i])
+        bounceDimensions[size_t(i)] = samplers_[size_t(i)].reserve(Sampler::kBounceDimensions);
+    HitPacket4 hits;
+    t_.scene_->intersect4(LaneArray(alive_).value, packet(p_.origin, p_.direction, kInfinity),
+                          &hits);
+    rays_.closestHit += uint64_t(countLanes(alive_));
+
+    Mask ended{};
+    for (int i = 0; i < L::kWidth; ++i)
+      if (alive_[i] && hits.geomID[i] == HitPacket4::kNoHit) escape(i), ended[i] = -1;
+    const Vertex v = vertex(hits);
+    const Mask atMaxDepth = v.hit & (p_.depth >= t_.settings_.maxDepth);
+    ended |= atMaxDepth;
+    const Mask scatters = v.hit & ~atMaxDepth;
+    const Draws u = draws(scatters, bounceDimensions);
+    const Mask lit = nextEvent(v, sampleLights(v, u, scatters));
+    const Mask lockNow = scatters & ~p_.locked;
+    p_.visibility =
+        L::select(lockNow, L::select(lit, L::splat(1.0f), L::splat(0.0f)), p_.visibility);
+    p_.locked |= lockNow;
+    ended |= scatters & ~scatter(v, u, scatters);
+    for (int i = 0; i < L::kWidth; ++i)
+      if (ended[i]) finishPath(i);
+  }
+
+  // Lane i's ray left the scene: the environment's radiance (MIS-weighted after a BSDF sample),
+  // and the documented features of an escaped ray.
+  void escape(int i) {
+    const bool previousDelta = p_.previousDelta[i] != 0;
+    const EnvironmentLight::Arrival arrival =
+        t_.lights_->environmentArrival(normalize(p_.direction.at(i)), !previousDelta);
+    if (!arrival.Le.isBlack()) {
+      const float w =
+          previousDelta ? 1.0f : powerHeuristic(p_.previousPdf[i], arrival.pdfSolidAngle);
+      p_.radiance.set(i, p_.radiance.rgbAt(i) + p_.beta.rgbAt(i) * arrival.Le * w);
+    }
+    if (!p_.locked[i]) {
+      p_.albedo.set(i, p_.beta.rgbAt(i));
+      p_.normal.set(i, Vec3f{});
+      p_.featureDepth[i] = 0;
+      p_.locked[i] = -1;
+      p_.visibility[i] = 1;
+    }
+  }
+
+  // Scene::interaction for the hit lanes (flat triangles in lanes, smooth ones one by one), the
+  // emission found there, the shading frame, and the features of paths not yet locked.
+  Vertex vertex(const HitPacket4& hits) {
+    const SceneData& data = t_.scene_->data();
+    Vertex v;
+    Mask smooth{}, doubleSided{};
+    L::Vec3 p0{}, p1{}, p2{}, ns{}, tangent{}, emission{};
+    Float u{}, w{}, distance{};
+    for (int i = 0; i < L::kWidth; ++i) {
+      if (!alive_[i] || hits.geomID[i] == HitPacket4::kNoHit) continue;
+      v.hit[i] = -1;
+      const SceneMesh& sm = data.meshes[hits.geomID[i]];
+      const uint32_t primID = hits.primID[i];
+      const LaneTracer::Surface& s = t_.surfaces_[size_t(sm.mesh.material)];
+      v.albedo.set(i, s.albedo);
+      v.f.set(i, s.f);
+      emission.set(i, s.emission);
+      doubleSided[i] = s.doubleSided ? -1 : 0;
+      distance[i] = hits.t[i];
+      if (sm.flatFrames.empty() || !sm.flatFrames[primID].valid) {
+        smooth[i] = -1;
+        const SurfaceInteraction& si = v.interaction[size_t(i)] = t_.scene_->interaction(
+            Hit{hits.t[i], hits.geomID[i], primID, hits.u[i], hits.v[i]}, p_.direction.at(i));
+        p0.set(i, si.position), p1.set(i, Vec3f{}), p2.set(i, Vec3f{});  // position = p0 · 1
+        u[i] = 0, w[i] = 0;
+        v.geometricNormal.set(i, si.geometricNormal);
+        ns.set(i, si.shadingNormal);
+        tangent.set(i, si.tangent);
+        v.positionError.set(i, si.positionError);
+        continue;
+      }
+      const uint32_t* idx = &sm.mesh.indices[3 * size_t(primID)];
+      p0.set(i, sm.mesh.positions[idx[0]]);
+      p1.set(i, sm.mesh.positions[idx[1]]);
+      p2.set(i, sm.mesh.positions[idx[2]]);
+      const SceneMesh::FlatFrame& flat = sm.flatFrames[primID];
+      v.geometricNormal.set(i, flat.geometricNormal);
+      ns.set(i, flat.shadingNormal);
+      tangent.set(i, flat.tangent);
+      u[i] = hits.u[i], w[i] = hits.v[i];
+    }
+    const Float b0 = 1.0f - u - w;
+    v.position = L::select(smooth, p0, p0 * b0 + p1 * u + p2 * w);
+    v.positionError =
+        L::select(smooth, v.positionError, barycentricPositionError(p0, p1, p2, b0, u, w));
+    const Float directionLength = L::length(p_.direction);
+    p_.pathLength = L::select(v.hit, p_.pathLength + distance * directionLength, p_.pathLength);
+
+    // Emission found by the previous BSDF sample (or seen directly): rare, so lane by lane.
+    const Mask frontFace = L::dot(p_.direction, v.geometricNormal) < 0.0f;
+    const Mask emitting = v.hit & ~L::isBlack(emission) & (frontFace | doubleSided);
+    for (int i = 0; i < L::kWidth && L::any(emitting); ++i) {
+      if (!emitting[i]) continue;
+      float weight = 1.0f;
+      if (!p_.previousDelta[i]) {
+        SurfaceInteraction si = v.interaction[size_t(i)];
+        si.position = v.position.at(i);
+        si.geometricNormal = v.geometricNormal.at(i);
+        si.geomID = hits.geomID[i];
+        si.primID = hits.primID[i];
+        weight = powerHeuristic(p_.previousPdf[i],
+                                t_.lights_->pdfAreaLight(p_.previousPosition.at(i), si));
+      }
+      p_.radiance.set(i, p_.radiance.rgbAt(i) + p_.beta.rgbAt(i) * emission.rgbAt(i) * weight);
+    }
+
+    // The shading frame, turned to the side the ray arrives on.
+    v.wo = -(p_.direction / directionLength);
+    const Mask flip = L::dot(v.wo, v.geometricNormal) < 0.0f;
+    v.ng = L::select(flip, -v.geometricNormal, v.geometricNormal);
+    ns = L::select(flip, -ns, ns);
+    v.frame = {tangent, L::cross(ns, tangent), ns};
+    v.woLocal = v.frame.toLocal(v.wo);
+    const Mask backFacing = v.hit & (v.woLocal.z < 1e-4f);
+    for (int i = 0; i < L::kWidth && L::any(backFacing); ++i) {
+      if (!backFacing[i]) continue;
+      // A shading normal that faces away from the viewer: shade with the geometric one.
+      const Frame g = Frame::fromZX(v.ng.at(i), tangent.at(i));
+      v.frame.x.set(i, g.x), v.frame.y.set(i, g.y), v.frame.z.set(i, g.z);
+      v.woLocal.set(i, g.toLocal(v.wo.at(i)));
+    }
+
+    const Mask record = v.hit & ~p_.locked;
+    p_.albedo = L::select(record, p_.beta * v.albedo, p_.albedo);
+    p_.normal = L::select(record, L::select(L::dot(v.frame.z, v.wo) < 0.0f, -v.frame.z, v.frame.z),
+                          p_.normal);
+    p_.featureDepth = L::select(record, p_.pathLength, p_.featureDepth);
+    return v;
+  }
+
+  Draws draws(Mask scatters, const std::array<uint32_t, L::kWidth>& bounceDimensions) {
+    Draws u;
+    for (int i = 0; i < L::kWidth; ++i) {
+      if (!scatters[i]) continue;
+      const Sampler::BounceDraws d = samplers_[size_t(i)].getBounce(bounceDimensions[size_t(i)]);
+      u.lobe[i] = d.lobe, u.directionX[i] = d.direction.x, u.directionY[i] = d.direction.y;
+      u.light[i] = d.light, u.lightX[i] = d.lightPoint.x, u.lightY[i] = d.lightPoint.y;
+      u.roulette[i] = d.roulette;
+    }
+    return u;
+  }
+
+  // LightSet::sample for every scattering lane: uniform area lights (the common case) in lanes,
+  // any other light through LightSet::sample itself.
+  LightLanes sampleLights(const Vertex& v, const Draws& u, Mask scatters) const {
+    LightLanes ls;
+    if (t_.lights_->empty()) return ls;
+    Float pmf{}, area{};
+    L::Vec3 l0{}, l1{}, l2{}, lightLe{};
+    Mask inLanes{}, doubleSided{};
+    for (int i = 0; i < L::kWidth; ++i) {
+      if (!scatters[i]) continue;
+      float choicePmf = 0;
+      const LightSet::AreaLight* light = t_.lights_->pickLight(u.light[i], &choicePmf);
+      if (!(choicePmf > 0)) continue;
+      if (light) {
+        inLanes[i] = -1;
+        pmf[i] = choicePmf;
+        area[i] = light->area;
+        l0.set(i, light->p0), l1.set(i, light->p1), l2.set(i, light->p2);
+        ls.nLight.set(i, light->normal);
+        lightLe.set(i, light->Le);
+        doubleSided[i] = light->doubleSided ? -1 : 0;
+        continue;
+      }
+      const std::optional<LightSample> s =
+          t_.lights_->sample(v.position.at(i), u.light[i], {u.lightX[i], u.lightY[i]});
+      if (!s) continue;
+      ls.sampled[i] = -1;
+      ls.delta[i] = s->isDelta ? -1 : 0;
+      ls.infinite[i] = s->isInfinite ? -1 : 0;
+      ls.wi.set(i, s->wi), ls.Li.set(i, s->Li), ls.pdf[i] = s->pdf;
+      ls.pLight.set(i, s->pLight), ls.pLightError.set(i, s->pLightError);
+      ls.nLight.set(i, s->nLight);
+    }
+    if (!L::any(inLanes)) return ls;
+
+    // LightSet::sampleArea with sampleUniformTriangle.
+    const Mask half = u.lightX < u.lightY;
+    const Float halfX = u.lightX / 2.0f, halfY = u.lightY / 2.0f;
+    const Float b0 = L::select(half, halfX, u.lightX - halfY);
+    const Float b1 = L::select(half, u.lightY - halfX, halfY);
+    const Float b2 = 1.0f - b0 - b1;
+    const L::Vec3 pLight = l0 * b0 + l1 * b1 + l2 * b2;
+    const L::Vec3 toLight = pLight - v.position;
+    const Float distanceSquared = L::dot(toLight, toLight);
+    const L::Vec3 wi = toLight / L::sqrt(distanceSquared);
+    const L::Vec3 Li = L::select(doubleSided | (L::dot(wi, ls.nLight) < 0.0f), lightLe, L::Vec3{});
+    const Float cosLight = L::abs(L::dot(ls.nLight, wi));
+    const Float pdf = distanceSquared / (cosLight * area);
+    const Mask sampled = inLanes & (area > 0.0f) & (distanceSquared > 0.0f) & (cosLight > 0.0f) &
+                         (pdf > 0.0f) & ~L::isBlack(Li);
+    ls.sampled |= sampled;
+    ls.wi = L::select(inLanes, wi, ls.wi);
+    ls.Li = L::select(inLanes, Li, ls.Li);
+    ls.pdf = L::select(inLanes, pdf * pmf, ls.pdf);
+    ls.pLight = L::select(inLanes, pLight, ls.pLight);
+    ls.pLightError =
+        L::select(inLanes, barycentricPositionError(l0, l1, l2, b0, b1, b2), ls.pLightError);
+    return ls;
+  }
+
+  // Next-event estimation with the light samples: the Lambertian BSDF, the shadow rays as one
+  // packet, MIS against BSDF sampling. Returns the lanes whose light was unoccluded.
+  Mask nextEvent(const Vertex& v, const LightLanes& ls) {
+    const L::Vec3 wiLocal = v.frame.toLocal(ls.wi);
+    const Mask sameSide = (L::dot(ls.wi, v.ng) > 0.0f) == (L::dot(v.wo, v.ng) > 0.0f);
+    const Mask evaluated = grazingSafe(v.woLocal) & grazingSafe(wiLocal) &
+                           ((v.woLocal.z < 0.0f) == (wiLocal.z < 0.0f));
+    const L::Vec3 f = v.f * L::abs(wiLocal.z);
+    const Mask shadow = ls.sampled & sameSide & evaluated & ~L::isBlack(f);
+    if (!L::any(shadow)) return Mask{};
+    const L::Vec3 from = offsetRayOrigin(v.position, v.positionError, v.ng, ls.wi);
+    const L::Vec3 to =
+        L::select(L::dot(ls.nLight, ls.nLight) > 0.0f,
+                  offsetRayOrigin(ls.pLight, ls.pLightError, ls.nLight, -ls.wi), ls.pLight);
+    LaneArray blocked(Mask{});
+    t_.scene_->occluded4(LaneArray(shadow).value,
+                         packet(from, L::select(ls.infinite, ls.wi, to - from),
+                                L::select(ls.infinite, kInfinity, L::splat(1.0f - kShadowEpsilon))),
+                         blocked.value);
+    rays_.shadow += uint64_t(countLanes(shadow));
+    Mask blockedLanes;
+    std::memcpy(&blockedLanes, blocked.value, sizeof blockedLanes);
+    const Mask lit = shadow & ~blockedLanes;
+    const Float w = L::select(ls.delta, L::splat(1.0f),
+                              powerHeuristic(ls.pdf, cosineHemispherePdf(L::abs(wiLocal.z))));
+    p_.radiance = L::select(lit, p_.radiance + p_.beta * f * ls.Li * (w / ls.pdf), p_.radiance);
+    return lit;
+  }
+
+  // Continues the paths by sampling the BSDF (Bsdf::sample for a plain Lambertian), then
+  // Russian roulette. Returns the lanes whose path goes on.
+  Mask scatter(const Vertex& v, const Draws& u, Mask scatters) {
+    L::Vec3 wi = sampleCosineHemisphere(u.directionX, u.directionY);
+    const Float pdf = cosineHemispherePdf(wi.z);
+    Mask continues = scatters & grazingSafe(v.woLocal) & L::isFinite(u.lobe) &
+                     L::isFinite(u.directionX) & L::isFinite(u.directionY) & grazingSafe(wi) &
+                     (pdf > 0.0f) & ~L::isBlack(v.f);
+    wi.z = L::select(v.woLocal.z < 0.0f, -wi.z, wi.z);
+    const L::Vec3 wiWorld = v.frame.fromLocal(wi);
+    // Directions whose side of the geometric surface contradicts the lobe would leak light.
+    continues &= (L::dot(wiWorld, v.ng) > 0.0f) == (L::dot(v.wo, v.ng) > 0.0f);
+    const L::Vec3 beta = p_.beta * (v.f * (L::abs(wi.z) / pdf));
+    const Mask roulette = continues & (p_.depth + 1 >= t_.settings_.rouletteStartDepth);
+    const Float survive = L::min(L::splat(1.0f), L::maxComponent(beta));
+    continues &= ~(roulette & ~(u.roulette < survive));
+    p_.beta = L::select(continues, L::select(roulette, beta / survive, beta), p_.beta);
+    p_.previousDelta &= ~continues;
+    p_.previousPdf = L::select(continues, pdf, p_.previousPdf);
+    p_.previousPosition = L::select(continues, v.position, p_.previousPosition);
+    p_.origin = L::select(continues, offsetRayOrigin(v.position, v.positionError, v.ng, wiWorld),
+                          p_.origin);
+    p_.direction = L::select(continues, wiWorld, p_.direction);
+    p_.depth -= continues;  // + 1 where the path goes on (masks are −1)
+    return continues;
+  }
+
+  static inline const Float kInfinity = L::splat(std::numeric_limits<float>::infinity());
+
+  const LaneTracer& t_;
+  const LaneTracer::Tile& tile_;
+  const LaneTracer::Sampling& sampling_;
+  const Camera& camera_;
+  Film& film_;
+  PathTracer::RayCounts& rays_;
+  uint64_t& dropped_;
+  std::array<Lane, L::kWidth> lanes_;
+  std::array<Sampler, L::kWidth> samplers_;
+  int nextPixel_ = 0;
+  Paths p_{};
+  Mask alive_{};
+};
 
 std::optional<LaneTracer> LaneTracer::create(const Scene& scene, const LightSet& lights,
                                              PathTracerSettings settings) {
-  if (!lights.onlyUniformAreaLights()) return std::nullopt;
-  const SceneData& data = scene.data();
-  for (const SceneMesh& sm : data.meshes) {
-    if (sm.alphaTested || sm.flatFrames.size() != sm.mesh.triangleCount()) return std::nullopt;
-    for (const SceneMesh::FlatFrame& frame : sm.flatFrames)
-      if (!frame.valid) return std::nullopt;
-  }
   LaneTracer tracer(scene, lights, settings);
-  for (const Material& material : data.materials) {
+  for (const SceneMesh& sm : scene.data().meshes)
+    if (sm.alphaTested) return std::nullopt;
+  for (const Material& material : scene.data().materials) {
     const MaterialDesc& m = material.desc;
     const Bsdf* bsdf = material.uniformBsdf ? &*material.uniformBsdf : nullptr;
     if (!bsdf || !(bsdf->isPlainLambertian() || bsdf->scattersNothing()) || m.hasVolume ||
@@ -157,255 +531,7 @@ std::optional<LaneTracer> LaneTracer::create(const Scene& scene, const LightSet&
 
 void LaneTracer::renderTile(const Tile& tile, const Sampling& sampling, const Camera& camera,
                             Film& film, PathTracer::RayCounts& rays, uint64_t& dropped) const {
-  const SceneData& data = scene_->data();
-  const int tileWidth = tile.x1 - tile.x0;
-  const int pixelCount = tileWidth * (tile.y1 - tile.y0);
-  int nextPixel = 0;
-
-  // Per lane: its pixel, the sample being traced, the pixel's accumulators and its sampler.
-  struct Lane {
-    int x = 0, y = 0, sample = 0;
-    PixelAccumulator pixel;
-  };
-  std::array<Lane, L::kWidth> lane;
-  std::array<Sampler, L::kWidth> samplers{Sampler(sampling.seed), Sampler(sampling.seed),
-                                          Sampler(sampling.seed), Sampler(sampling.seed)};
-  Paths p{};
-  Mask alive{};
-
-  const auto startSample = [&](int i) {
-    Lane& l = lane[size_t(i)];
-    Sampler& sampler = samplers[size_t(i)];
-    sampler.startPixelSample(l.x, l.y, uint32_t(l.sample / sampling.splits),
-                             l.sample % sampling.splits);
-    const Vec2f offset = sampler.getPixel2D();
-    p.start(i, camera.generateRay({float(l.x) + offset.x, float(l.y) + offset.y}));
-  };
-  const auto takePixel = [&](int i) {
-    if (nextPixel == pixelCount) {
-      alive[i] = 0;
-      return;
-    }
-    Lane& l = lane[size_t(i)];
-    l.x = tile.x0 + nextPixel % tileWidth;
-    l.y = tile.y0 + nextPixel / tileWidth;
-    ++nextPixel;
-    l.sample = 0;
-    l.pixel = PixelAccumulator{};
-    alive[i] = -1;
-    startSample(i);
-  };
-  // The path of lane i has ended: accumulate it, then start the next sample or pixel.
-  const auto finishPath = [&](int i) {
-    Lane& l = lane[size_t(i)];
-    if (!l.pixel.add(l.sample % sampling.splits, p.sample(i))) ++dropped;
-    if (++l.sample < sampling.spp) return startSample(i);
-    film.store(l.x, l.y, l.pixel);
-    takePixel(i);
-  };
-  for (int i = 0; i < L::kWidth; ++i) takePixel(i);
-
-  const Float inf = L::splat(std::numeric_limits<float>::infinity());
-  while (L::any(alive)) {
-    // Closest hits of the lanes' rays.
-    std::array<uint32_t, L::kWidth> bounceDimensions{};
-    RayPacket4 packet;
-    for (int i = 0; i < L::kWidth; ++i) {
-      if (!alive[i]) continue;
-      bounceDimensions[size_t(i)] = samplers[size_t(i)].reserve(Sampler::kBounceDimensions);
-      packet.ox[i] = p.origin.x[i], packet.oy[i] = p.origin.y[i], packet.oz[i] = p.origin.z[i];
-      packet.dx[i] = p.direction.x[i], packet.dy[i] = p.direction.y[i];
-      packet.dz[i] = p.direction.z[i], packet.tMax[i] = inf[i];
-    }
-    HitPacket4 hits;
-    scene_->intersect4(LaneArray(alive).value, packet, &hits);
-    rays.closestHit += uint64_t(countLanes(alive));
-
-    // Gather what the hit lanes need; lanes that escaped record their features and end (no
-    // environment emits in the scenes this tracer takes).
-    Mask hit{}, ended{};
-    L::Vec3 p0{}, p1{}, p2{}, ng{}, ns{}, tangent{}, surfaceAlbedo{}, f{}, emission{};
-    Mask doubleSided{};
-    Float u{}, v{}, t{};
-    for (int i = 0; i < L::kWidth; ++i) {
-      if (!alive[i]) continue;
-      if (hits.geomID[i] == HitPacket4::kNoHit) {
-        if (!p.locked[i]) {
-          p.albedo.set(i, p.beta.rgbAt(i));
-          p.normal.set(i, Vec3f{});
-          p.featureDepth[i] = 0;
-          p.locked[i] = -1;
-          p.visibility[i] = 1;
-        }
-        ended[i] = -1;
-        continue;
-      }
-      hit[i] = -1;
-      const SceneMesh& sm = data.meshes[hits.geomID[i]];
-      const uint32_t* idx = &sm.mesh.indices[3 * size_t(hits.primID[i])];
-      p0.set(i, sm.mesh.positions[idx[0]]);
-      p1.set(i, sm.mesh.positions[idx[1]]);
-      p2.set(i, sm.mesh.positions[idx[2]]);
-      const SceneMesh::FlatFrame& flat = sm.flatFrames[hits.primID[i]];
-      ng.set(i, flat.geometricNormal);
-      ns.set(i, flat.shadingNormal);
-      tangent.set(i, flat.tangent);
-      const Surface& s = surfaces_[size_t(sm.mesh.material)];
-      surfaceAlbedo.set(i, s.albedo);
-      f.set(i, s.f);
-      emission.set(i, s.emission);
-      doubleSided[i] = s.doubleSided ? -1 : 0;
-      u[i] = hits.u[i], v[i] = hits.v[i], t[i] = hits.t[i];
-    }
-
-    // Scene::interaction for flat triangles.
-    const Float b0 = 1.0f - u - v;
-    const L::Vec3 position = p0 * b0 + p1 * u + p2 * v;
-    const L::Vec3 positionError = barycentricPositionError(p0, p1, p2, b0, u, v);
-    const Mask frontFace = L::dot(p.direction, ng) < 0.0f;
-    const Float directionLength = L::length(p.direction);
-    p.pathLength = L::select(hit, p.pathLength + t * directionLength, p.pathLength);
-
-    // Emission found by the previous BSDF sample (or seen directly): rare, so lane by lane.
-    const Mask emitting = hit & ~L::isBlack(emission) & (frontFace | doubleSided);
-    for (int i = 0; i < L::kWidth && L::any(emitting); ++i) {
-      if (!emitting[i]) continue;
-      float w = 1.0f;
-      if (!p.previousDelta[i]) {
-        SurfaceInteraction si;
-        si.position = position.at(i);
-        si.geometricNormal = ng.at(i);
-        si.geomID = hits.geomID[i];
-        si.primID = hits.primID[i];
-        w = chorus::render::powerHeuristic(p.previousPdf[i],
-                                           lights_->pdfAreaLight(p.previousPosition.at(i), si));
-      }
-      p.radiance.set(i, p.radiance.rgbAt(i) + p.beta.rgbAt(i) * emission.rgbAt(i) * w);
-    }
-
-    // The shading frame, turned to the side the ray arrives on.
-    const L::Vec3 wo = -(p.direction / directionLength);
-    const Mask flip = L::dot(wo, ng) < 0.0f;
-    ng = L::select(flip, -ng, ng);
-    ns = L::select(flip, -ns, ns);
-    LaneFrame frame{tangent, L::cross(ns, tangent), ns};
-    L::Vec3 woLocal = frame.toLocal(wo);
-    const Mask backFacing = hit & (woLocal.z < 1e-4f);
-    for (int i = 0; i < L::kWidth && L::any(backFacing); ++i) {
-      if (!backFacing[i]) continue;
-      // A shading normal that faces away from the viewer: shade with the geometric one.
-      const Frame g = Frame::fromZX(ng.at(i), tangent.at(i));
-      frame.x.set(i, g.x), frame.y.set(i, g.y), frame.z.set(i, g.z);
-      woLocal.set(i, g.toLocal(wo.at(i)));
-    }
-
-    const Mask record = hit & ~p.locked;
-    p.albedo = L::select(record, p.beta * surfaceAlbedo, p.albedo);
-    p.normal =
-        L::select(record, L::select(L::dot(frame.z, wo) < 0.0f, -frame.z, frame.z), p.normal);
-    p.featureDepth = L::select(record, p.pathLength, p.featureDepth);
-    const Mask atMaxDepth = hit & (p.depth >= settings_.maxDepth);
-    ended |= atMaxDepth;
-    const Mask scatter = hit & ~atMaxDepth;
-
-    // The vertex's sampler draws and light choice, lane by lane.
-    Float uLobe{}, uDirX{}, uDirY{}, uLightX{}, uLightY{}, uRoulette{}, pmf{}, area{};
-    L::Vec3 l0{}, l1{}, l2{}, lightNormal{}, lightLe{};
-    Mask picked{}, lightDoubleSided{};
-    for (int i = 0; i < L::kWidth; ++i) {
-      if (!scatter[i]) continue;
-      const Sampler::BounceDraws d = samplers[size_t(i)].getBounce(bounceDimensions[size_t(i)]);
-      uLobe[i] = d.lobe, uDirX[i] = d.direction.x, uDirY[i] = d.direction.y;
-      uLightX[i] = d.lightPoint.x, uLightY[i] = d.lightPoint.y, uRoulette[i] = d.roulette;
-      float choicePmf = 0;
-      const LightSet::AreaLight* light = lights_->pickAreaLight(d.light, &choicePmf);
-      if (!light) continue;
-      picked[i] = -1;
-      pmf[i] = choicePmf;
-      area[i] = light->area;
-      l0.set(i, light->p0), l1.set(i, light->p1), l2.set(i, light->p2);
-      lightNormal.set(i, light->normal);
-      lightLe.set(i, light->Le);
-      lightDoubleSided[i] = light->doubleSided ? -1 : 0;
-    }
-
-    // Next-event estimation (LightSet::sampleArea, then the BSDF and the shadow ray).
-    const Mask half = uLightX < uLightY;
-    const Float halfX = uLightX / 2.0f, halfY = uLightY / 2.0f;
-    const Float lb0 = L::select(half, halfX, uLightX - halfY);
-    const Float lb1 = L::select(half, uLightY - halfX, halfY);
-    const Float lb2 = 1.0f - lb0 - lb1;
-    const L::Vec3 pLight = l0 * lb0 + l1 * lb1 + l2 * lb2;
-    const L::Vec3 toLight = pLight - position;
-    const Float distanceSquared = L::dot(toLight, toLight);
-    const L::Vec3 wi = toLight / L::sqrt(distanceSquared);
-    const L::Vec3 Li =
-        L::select(lightDoubleSided | (L::dot(wi, lightNormal) < 0.0f), lightLe, L::Vec3{});
-    const Float cosLight = L::abs(L::dot(lightNormal, wi));
-    const Float lightPdf = distanceSquared / (cosLight * area) * pmf;
-    const Mask sampled = scatter & picked & (area > 0.0f) & (distanceSquared > 0.0f) &
-                         (cosLight > 0.0f) & (distanceSquared / (cosLight * area) > 0.0f) &
-                         ~L::isBlack(Li);
-    const L::Vec3 wiLocal = frame.toLocal(wi);
-    const Mask woAbove = L::dot(wo, ng) > 0.0f;
-    const Mask sameSide = (L::dot(wi, ng) > 0.0f) == woAbove;
-    const Mask evaluated =
-        grazingSafe(woLocal) & grazingSafe(wiLocal) & ((woLocal.z < 0.0f) == (wiLocal.z < 0.0f));
-    const L::Vec3 fCos = f * L::abs(wiLocal.z);
-    const Mask shadow = sampled & sameSide & evaluated & ~L::isBlack(fCos);
-    Mask lit{};
-    if (L::any(shadow)) {
-      const L::Vec3 from = offsetRayOrigin(position, positionError, ng, wi);
-      const L::Vec3 to = offsetRayOrigin(
-          pLight, barycentricPositionError(l0, l1, l2, lb0, lb1, lb2), lightNormal, -wi);
-      const L::Vec3 span = to - from;
-      RayPacket4 shadowRays;
-      for (int i = 0; i < L::kWidth; ++i) {
-        shadowRays.ox[i] = from.x[i], shadowRays.oy[i] = from.y[i], shadowRays.oz[i] = from.z[i];
-        shadowRays.dx[i] = span.x[i], shadowRays.dy[i] = span.y[i], shadowRays.dz[i] = span.z[i];
-        shadowRays.tMax[i] = 1.0f - kShadowEpsilon;
-      }
-      LaneArray blocked(Mask{});
-      scene_->occluded4(LaneArray(shadow).value, shadowRays, blocked.value);
-      rays.shadow += uint64_t(countLanes(shadow));
-      Mask blockedLanes;
-      std::memcpy(&blockedLanes, blocked.value, sizeof blockedLanes);
-      lit = shadow & ~blockedLanes;
-      const Float w = powerHeuristic(lightPdf, cosineHemispherePdf(L::abs(wiLocal.z)));
-      p.radiance = L::select(lit, p.radiance + p.beta * fCos * Li * (w / lightPdf), p.radiance);
-    }
-    const Mask lockNow = scatter & ~p.locked;
-    p.visibility = L::select(lockNow, L::select(lit, L::splat(1.0f), L::splat(0.0f)), p.visibility);
-    p.locked |= lockNow;
-
-    // Continue the paths by sampling the BSDF (Bsdf::sample for a plain Lambertian).
-    L::Vec3 wiSampled = sampleCosineHemisphere(uDirX, uDirY);
-    const Float bsdfPdf = cosineHemispherePdf(wiSampled.z);
-    Mask continues = scatter & grazingSafe(woLocal) & L::isFinite(uLobe) & L::isFinite(uDirX) &
-                     L::isFinite(uDirY) & grazingSafe(wiSampled) & (bsdfPdf > 0.0f) &
-                     ~L::isBlack(f);
-    wiSampled.z = L::select(woLocal.z < 0.0f, -wiSampled.z, wiSampled.z);
-    const L::Vec3 wiWorld = frame.fromLocal(wiSampled);
-    // Directions whose side of the geometric surface contradicts the lobe would leak light.
-    continues &= (L::dot(wiWorld, ng) > 0.0f) == woAbove;
-    const L::Vec3 beta = p.beta * (f * (L::abs(wiSampled.z) / bsdfPdf));
-    const Mask roulette = continues & (p.depth + 1 >= settings_.rouletteStartDepth);
-    const Float survive = L::min(L::splat(1.0f), L::maxComponent(beta));
-    const Mask dies = roulette & ~(uRoulette < survive);
-    continues &= ~dies;
-    p.beta = L::select(continues, L::select(roulette, beta / survive, beta), p.beta);
-    p.previousDelta &= ~continues;
-    p.previousPdf = L::select(continues, bsdfPdf, p.previousPdf);
-    p.previousPosition = L::select(continues, position, p.previousPosition);
-    p.origin =
-        L::select(continues, offsetRayOrigin(position, positionError, ng, wiWorld), p.origin);
-    p.direction = L::select(continues, wiWorld, p.direction);
-    p.depth -= continues;  // + 1 where the path goes on (masks are −1)
-    ended |= scatter & ~continues;
-
-    for (int i = 0; i < L::kWidth; ++i)
-      if (ended[i]) finishPath(i);
-  }
+  LaneTileRenderer(*this, tile, sampling, camera, film, rays, dropped).run();
 }
 
 }  // namespace chorus::render

@@ -16,6 +16,8 @@
 
 namespace chorus::render {
 
+class LaneTileRenderer;
+
 class LaneTracer {
  public:
   // A tracer for the scene, or nothing when anything in it needs the general tracer (textures,
@@ -48,6 +50,7 @@ class LaneTracer {
   LaneTracer(const Scene& scene, const LightSet& lights, PathTracerSettings settings)
       : scene_(&scene), lights_(&lights), settings_(settings) {}
 
+  friend class LaneTileRenderer;
   const Scene* scene_;
   const LightSet* lights_;
   PathTracerSettings settings_;

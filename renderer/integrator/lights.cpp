@@ -147,12 +147,6 @@ std::optional<LightSample> LightSet::sample(const Vec3f& ref, float uChoice, Vec
   return s;
 }
 
-bool LightSet::onlyUniformAreaLights() const {
-  return !lights_.empty() && lights_.size() == areaLights_.size() &&
-         std::all_of(areaLights_.begin(), areaLights_.end(),
-                     [](const AreaLight& light) { return light.uniform; });
-}
-
 bool LightSet::sampleArea(const AreaLight& light, const Vec3f& ref, Vec2f u, LightSample& s) const {
   if (!(light.area > 0)) return false;
   const Vec2f b = sampleUniformTriangle(u);

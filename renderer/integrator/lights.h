@@ -54,14 +54,11 @@ class LightSet {
     Rgb Le;
   };
 
-  // True when there are lights and every one is a uniform area light: no punctual light, no
-  // environment, no textured emission (the case LaneTracer handles).
-  bool onlyUniformAreaLights() const;
-  // The light sample() picks with uChoice, when onlyUniformAreaLights(); null where its
-  // probability is 0 (sample() returns nothing then).
-  const AreaLight* pickAreaLight(float uChoice, float* pmf) const {
-    const int index = choice_.sample(uChoice, pmf);
-    return *pmf > 0 ? &areaLights_[size_t(index)] : nullptr;
+  // The light sample() picks with uChoice, and its probability; the light itself when it is a
+  // uniform area light (whose sampling the lane tracer repeats in SIMD lanes), else null.
+  const AreaLight* pickLight(float uChoice, float* pmf) const {
+    const size_t index = size_t(choice_.sample(uChoice, pmf));
+    return index < areaLights_.size() && areaLights_[index].uniform ? &areaLights_[index] : nullptr;
   }
 
  private:

@@ -52,8 +52,13 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
   const LightSet lights(scene);
   const PathTracerSettings settings{options.maxDepth, options.rouletteStartDepth};
   const PathTracer tracer(scene, lights, settings);
-  const std::optional<LaneTracer> laneTracer =
-      options.lanes ? LaneTracer::create(scene, lights, settings) : std::nullopt;
+  std::optional<LaneTracer> laneTracer;
+  if (options.tracer != RenderOptions::Tracer::OnePath) {
+    laneTracer.emplace(scene, lights, settings);
+    if (options.tracer == RenderOptions::Tracer::Automatic &&
+        laneTracer->laneAreaShare() < LaneTracer::kWorthwhileAreaShare)
+      laneTracer.reset();
+  }
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   Film film =
       arena.execute([&] { return Film(resolution.width, resolution.height, options.splits); });

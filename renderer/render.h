@@ -31,9 +31,11 @@ struct RenderOptions {
   // with renderers that trace every path to full length).
   int rouletteStartDepth = 3;
   int camera = 0;  // index into the scene's cameras (0 with none: frame the bounds)
-  // Trace scenes of plain Lambertian surfaces and area lights four paths at a time
-  // (LaneTracer, bit-identical images); false: always the general one-path tracer.
-  bool lanes = true;
+  // Which path tracer renders (the images are bit-identical; only the speed differs):
+  // Automatic takes LaneTracer (four paths in SIMD lanes) when at least half the scene's surface
+  // area is shaded in lanes (plain Lambertian materials), else PathTracer one path at a time.
+  enum class Tracer { Automatic, Lanes, OnePath };
+  Tracer tracer = Tracer::Automatic;
 };
 
 struct RenderStats {

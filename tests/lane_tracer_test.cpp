@@ -1,10 +1,10 @@
 // LaneTracer (four paths in SIMD lanes) against the one-path PathTracer it stands in for: the
-// same buffers bit for bit on every scene it takes, and the scenes it must leave to the general
-// tracer.
+// same buffers bit for bit, on scenes that exercise each of its lane and one-by-one paths.
 #include <gtest/gtest.h>
 #include <stb_image_write.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "renderer/integrator/lane_tracer.h"
 #include "renderer/render.h"
@@ -37,9 +37,9 @@ bool sameImage(const Image& a, const Image& b) {
 // Renders with lanes and without and expects equal buffers, mean and variance of every
 // quantity of every sub-buffer; returns the scalar render's mean colour for sanity checks.
 double expectLanesEqualScalar(const Scene& scene, RenderOptions o) {
-  o.lanes = false;
+  o.tracer = RenderOptions::Tracer::OnePath;
   const RenderResult scalar = render(scene, o);
-  o.lanes = true;
+  o.tracer = RenderOptions::Tracer::Lanes;
   const RenderResult lanes = render(scene, o);
   for (int k = 0; k < o.splits; ++k)
     for (Quantity q : kAllQuantities) {
@@ -66,7 +66,6 @@ Scene loadScene(const std::filesystem::path& path, EnvironmentDesc environment =
 
 TEST(LaneTracer, CornellBoxBitIdenticalToTheScalarTracer) {
   const Scene scene = loadScene(test::sourceDir() / "scenes/cornell-box.gltf");
-  ASSERT_TRUE(LaneTracer::create(scene, LightSet(scene), PathTracerSettings{}).has_value());
   // 37×29: partial tiles, lanes that run out of pixels at different times.
   const double mean = expectLanesEqualScalar(scene, options(37, 29, 6, 2));
   EXPECT_GT(mean, 0.01);  // lit, not an empty comparison
@@ -132,27 +131,87 @@ TEST(LaneTracer, OpenRoomWithEveryKindOfLightBitIdentical) {
                          options(17, 15, 4, 4));
 }
 
-TEST(LaneTracer, LeavesOtherMaterialsToTheGeneralTracer) {
+// Surfaces the lanes hand to their Bsdf one by one: glass with a volume, smooth and rough
+// metal, textured and normal-mapped materials with the default specular layer (the project's
+// own scenes), and alpha-masked, textured-emission and glossy surfaces in lanes next to
+// Lambertian ones.
+TEST(LaneTracer, EveryOtherMaterialBitIdentical) {
+  expectLanesEqualScalar(loadScene(test::sourceDir() / "scenes/glass-and-metal.gltf"),
+                         options(29, 23, 6, 2));
+  expectLanesEqualScalar(loadScene(test::sourceDir() / "scenes/punctual-lights.gltf"),
+                         options(29, 23, 6, 4));
+
   test::TempDir dir;
-  const auto accepts = [&](json floorMaterial) {
+  GltfBuilder b;
+  std::vector<uint8_t> rgba;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) {
+      const bool on = (x + y) % 2 == 0;
+      rgba.insert(rgba.end(),
+                  {uint8_t(on ? 230 : 40), 120, uint8_t(on ? 30 : 200), uint8_t(on ? 255 : 0)});
+    }
+  const int texture = b.addTexture(4, 4, rgba);
+  b.addQuad({-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3},
+            b.addMaterial(test::lambertianMaterial(0.7f, 0.7f, 0.7f)));
+  json leaves = test::lambertianMaterial(1, 1, 1);
+  leaves["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", texture}};
+  leaves["alphaMode"] = "MASK";
+  leaves["doubleSided"] = true;
+  b.addQuad({-1, 0.1f, -0.5f}, {1, 0.1f, -0.5f}, {1, 1.5f, -0.5f}, {-1, 1.5f, -0.5f},
+            b.addMaterial(leaves));
+  json sign = test::lambertianMaterial(0, 0, 0);
+  sign["emissiveFactor"] = {3, 3, 3};
+  sign["emissiveTexture"] = {{"index", texture}};
+  b.addQuad({-0.5f, 2, -0.5f}, {0.5f, 2, -0.5f}, {0.5f, 2, 0.5f}, {-0.5f, 2, 0.5f},
+            b.addMaterial(sign));
+  b.addSphere({0.6f, 0.4f, 0.4f}, 0.4f,
+              b.addMaterial({{"pbrMetallicRoughness",
+                              {{"baseColorFactor", {0.2, 0.3, 0.8, 1}},
+                               {"metallicFactor", 0.0},
+                               {"roughnessFactor", 0.4}}}}),
+              16);
+  const int cam =
+      b.addCamera({{"type", "perspective"}, {"perspective", {{"yfov", 1.1}, {"znear", 0.01}}}});
+  b.addNode({{"camera", cam}, {"translation", {0, 1.2, 3}}, {"rotation", {-0.17, 0, 0, 0.985}}});
+  b.writeGltf(dir / "mixed.gltf");
+  EXPECT_GT(expectLanesEqualScalar(
+                loadScene(dir / "mixed.gltf", EnvironmentDesc::constant(Rgb(0.2f, 0.2f, 0.3f))),
+                options(31, 19, 6, 2)),
+            0.01);
+}
+
+// Automatic picks the lanes where at least half the surface area is plain Lambertian.
+TEST(LaneTracer, AutomaticChoiceFollowsTheLambertianAreaShare) {
+  test::TempDir dir;
+  const auto twoQuads = [&](float lambertianSide, float metalSide) {
     GltfBuilder b;
-    b.addQuad({-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}, b.addMaterial(floorMaterial));
-    b.writeGltf(dir / "floor.gltf");
-    const Scene scene = loadScene(dir / "floor.gltf");
-    return LaneTracer::create(scene, LightSet(scene), PathTracerSettings{}).has_value();
+    const float l = lambertianSide, m = metalSide;
+    b.addQuad({0, 0, 0}, {l, 0, 0}, {l, l, 0}, {0, l, 0},
+              b.addMaterial(test::lambertianMaterial(0.5f, 0.5f, 0.5f)));
+    b.addQuad({0, 0, 1}, {m, 0, 1}, {m, m, 1}, {0, m, 1},
+              b.addMaterial({{"pbrMetallicRoughness", {{"metallicFactor", 1.0}}}}));
+    const int cam =
+        b.addCamera({{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", 0.01}}}});
+    b.addNode({{"camera", cam}, {"translation", {1, 1, 5}}});
+    b.writeGltf(dir / "quads.gltf");
+    return loadScene(dir / "quads.gltf");
   };
-  EXPECT_TRUE(accepts(test::lambertianMaterial(0.5f, 0.5f, 0.5f)));
-  EXPECT_FALSE(
-      accepts({{"pbrMetallicRoughness", {{"metallicFactor", 1.0}, {"roughnessFactor", 0.3}}}}));
-  // The default KHR_materials_specular layer over the diffuse base.
-  EXPECT_FALSE(accepts({{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}}));
-  json glass = test::lambertianMaterial(0.5f, 0.5f, 0.5f);
-  glass["extensions"]["KHR_materials_transmission"] = {{"transmissionFactor", 1.0}};
-  EXPECT_FALSE(accepts(glass));
-  json masked = test::lambertianMaterial(0.5f, 0.5f, 0.5f);
-  masked["alphaMode"] = "MASK";
-  masked["pbrMetallicRoughness"]["baseColorFactor"] = {0.5, 0.5, 0.5, 0.2};
-  EXPECT_FALSE(accepts(masked));
+  const auto share = [](const Scene& scene) {
+    return LaneTracer(scene, LightSet(scene), PathTracerSettings{}).laneAreaShare();
+  };
+  const auto usesLanes = [](const Scene& scene) {
+    return render(scene, options(8, 8, 1, 1)).stats.lanes;
+  };
+  const Scene quarter = twoQuads(1, std::sqrt(3.0f));  // areas 1 and 3
+  EXPECT_NEAR(share(quarter), 0.25f, 1e-5f);
+  EXPECT_FALSE(usesLanes(quarter));
+  const Scene threeQuarters = twoQuads(std::sqrt(3.0f), 1);
+  EXPECT_NEAR(share(threeQuarters), 0.75f, 1e-5f);
+  EXPECT_TRUE(usesLanes(threeQuarters));
+  const Scene cornell = loadScene(test::sourceDir() / "scenes/cornell-box.gltf");
+  EXPECT_EQ(share(cornell), 1.0f);
+  EXPECT_TRUE(usesLanes(cornell));
+  EXPECT_FALSE(usesLanes(loadScene(test::sourceDir() / "scenes/glass-and-metal.gltf")));
 }
 
 }  // namespace

@@ -80,6 +80,21 @@ TEST(RenderCli, WritesExrPngAndStats) {
   EXPECT_EQ(buffers.width(), 12);
   EXPECT_EQ(buffers.sub(2).sampleCount.at(3, 3, 0), 2.0f);
   EXPECT_GT(buffers.part(BufferPart::Full).color.mean.at(6, 4, 0), 0.0f);
+
+  // --tracer one-path renders the same buffers one path at a time.
+  const auto onePathOut = dir / "one-path";
+  const auto r2 =
+      runChorus({"render", scene.string(), "--spp", "8", "--width", "12", "--splits", "4", "--seed",
+                 "3", "--denoise", "none", "--tracer", "one-path", "--out", onePathOut.string()});
+  ASSERT_EQ(r2.exitCode, 0) << r2.err;
+  std::ifstream onePathStats(onePathOut / "stats.json");
+  EXPECT_EQ(json::parse(onePathStats)["tracer"], "one-path");
+  const SampleBuffers onePath =
+      sampleBuffersFromLayers(readExr(onePathOut / "render.exr"), onePathOut / "render.exr");
+  for (int k = 0; k < 4; ++k) {
+    const auto a = onePath.sub(k).color.mean.values(), b = buffers.sub(k).color.mean.values();
+    EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end())) << k;
+  }
 }
 
 TEST(RenderCli, QuietPrintsNothingAndNoLightsGetsOneLine) {

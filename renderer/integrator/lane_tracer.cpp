@@ -83,7 +83,9 @@ struct Paths {
   L::Vec3 origin, direction;
   L::Vec3 radiance, beta;
   Float previousPdf, pathLength;
+  Float etaScale;  // radiance scaling by refraction, removed for roulette decisions
   Mask previousDelta;
+  std::array<int, L::kWidth> volumeMaterial;  // the material whose interior the path is in, or −1
   L::Vec3 previousPosition;
   L::Int depth;
   // Features (PathTracer's FeatureRecorder): set while not locked.
@@ -98,6 +100,8 @@ struct Paths {
     beta.set(i, Rgb(1.0f));
     previousPdf[i] = 0;
     pathLength[i] = 0;
+    etaScale[i] = 1;
+    volumeMaterial[size_t(i)] = -1;
     previousDelta[i] = -1;  // the camera ray counts as a delta event: no MIS on its hit
     previousPosition.set(i, ray.origin);
     depth[i] = 0;
@@ -139,16 +143,19 @@ RayPacket4 packet(const L::Vec3& origin, const L::Vec3& direction, Float tMax) {
   return r;
 }
 
-// What PathTracer::trace knows at a hit point, for the lanes in `hit`.
+// What PathTracer::trace knows at a hit point, for the lanes in `hit`. Plain Lambertian (and
+// black) surfaces are shaded in lanes; lanes in `general` have any other BSDF, which they
+// evaluate and sample one by one through their Bsdf.
 struct Vertex {
-  Mask hit{};
+  Mask hit{}, general{}, transmissive{}, specular{};
   L::Vec3 position{}, positionError{};
-  L::Vec3 geometricNormal{};  // as Scene::interaction gives it (for emission and MIS)
-  L::Vec3 ng{};               // turned to the side the ray arrives on
+  L::Vec3 geometricNormal{};  // as Scene::interaction gives it (for emission, MIS and volumes)
+  L::Vec3 ng{};               // turned to the side the ray arrives on (opaque surfaces)
   L::Vec3 wo{}, woLocal{};
   LaneFrame frame{};
-  L::Vec3 albedo{}, f{};  // Bsdf::albedo() and the Lambertian f (0 for black surfaces)
-  std::array<SurfaceInteraction, L::kWidth> interaction;  // lanes on smooth triangles only
+  L::Vec3 albedo{}, f{};  // Bsdf::albedo(), and the Lambertian f (0 for black) outside `general`
+  std::array<const Bsdf*, L::kWidth> bsdf{};  // `general` lanes
+  std::array<int, L::kWidth> material{};
 };
 
 // A vertex's sampler draws (Sampler::BounceDraws), a lane each.
@@ -246,8 +253,8 @@ class LaneTileRenderer {
     ended |= atMaxDepth;
     const Mask scatters = v.hit & ~atMaxDepth;
     const Draws u = draws(scatters, bounceDimensions);
-    const Mask lit = nextEvent(v, sampleLights(v, u, scatters));
-    const Mask lockNow = scatters & ~p_.locked;
+    const Mask lit = nextEvent(v, sampleLights(v, u, scatters & ~v.specular));
+    const Mask lockNow = scatters & ~v.specular & ~p_.locked;
     p_.visibility =
         L::select(lockNow, L::select(lit, L::splat(1.0f), L::splat(0.0f)), p_.visibility);
     p_.locked |= lockNow;
@@ -276,12 +283,14 @@ class LaneTileRenderer {
     }
   }
 
-  // Scene::interaction for the hit lanes (flat triangles in lanes, smooth ones one by one), the
-  // emission found there, the shading frame, and the features of paths not yet locked.
+  // Scene::interaction for the hit lanes (flat Lambertian triangles in lanes, others one by
+  // one), the volume attenuation and emission up to there, the shading frame, and the features
+  // of paths not yet locked.
   Vertex vertex(const HitPacket4& hits) {
     const SceneData& data = t_.scene_->data();
     Vertex v;
-    Mask smooth{}, doubleSided{};
+    Mask full{}, doubleSided{};  // full: the lane's SurfaceInteraction comes from the scene
+    std::array<SurfaceInteraction, L::kWidth> si;
     L::Vec3 p0{}, p1{}, p2{}, ns{}, tangent{}, emission{};
     Float u{}, w{}, distance{};
     for (int i = 0; i < L::kWidth; ++i) {
@@ -289,67 +298,93 @@ class LaneTileRenderer {
       v.hit[i] = -1;
       const SceneMesh& sm = data.meshes[hits.geomID[i]];
       const uint32_t primID = hits.primID[i];
-      const LaneTracer::Surface& s = t_.surfaces_[size_t(sm.mesh.material)];
-      v.albedo.set(i, s.albedo);
-      v.f.set(i, s.f);
-      emission.set(i, s.emission);
-      doubleSided[i] = s.doubleSided ? -1 : 0;
+      const int materialIndex = sm.mesh.material;
+      const LaneTracer::Surface& s = t_.surfaces_[size_t(materialIndex)];
+      v.material[size_t(i)] = materialIndex;
       distance[i] = hits.t[i];
-      if (sm.flatFrames.empty() || !sm.flatFrames[primID].valid) {
-        smooth[i] = -1;
-        const SurfaceInteraction& si = v.interaction[size_t(i)] = t_.scene_->interaction(
+      if (s.inLanes && !sm.flatFrames.empty() && sm.flatFrames[primID].valid) {
+        const uint32_t* idx = &sm.mesh.indices[3 * size_t(primID)];
+        p0.set(i, sm.mesh.positions[idx[0]]);
+        p1.set(i, sm.mesh.positions[idx[1]]);
+        p2.set(i, sm.mesh.positions[idx[2]]);
+        const SceneMesh::FlatFrame& flat = sm.flatFrames[primID];
+        v.geometricNormal.set(i, flat.geometricNormal);
+        ns.set(i, flat.shadingNormal);
+        tangent.set(i, flat.tangent);
+        u[i] = hits.u[i], w[i] = hits.v[i];
+      } else {
+        full[i] = -1;
+        const SurfaceInteraction& f = si[size_t(i)] = t_.scene_->interaction(
             Hit{hits.t[i], hits.geomID[i], primID, hits.u[i], hits.v[i]}, p_.direction.at(i));
-        p0.set(i, si.position), p1.set(i, Vec3f{}), p2.set(i, Vec3f{});  // position = p0 · 1
-        u[i] = 0, w[i] = 0;
-        v.geometricNormal.set(i, si.geometricNormal);
-        ns.set(i, si.shadingNormal);
-        tangent.set(i, si.tangent);
-        v.positionError.set(i, si.positionError);
+        p0.set(i, f.position);
+        v.positionError.set(i, f.positionError);
+        v.geometricNormal.set(i, f.geometricNormal);
+        ns.set(i, f.shadingNormal);
+        tangent.set(i, f.tangent);
+      }
+      if (s.inLanes) {
+        v.albedo.set(i, s.albedo);
+        v.f.set(i, s.f);
+        emission.set(i, s.emission);
+        doubleSided[i] = s.doubleSided ? -1 : 0;
         continue;
       }
-      const uint32_t* idx = &sm.mesh.indices[3 * size_t(primID)];
-      p0.set(i, sm.mesh.positions[idx[0]]);
-      p1.set(i, sm.mesh.positions[idx[1]]);
-      p2.set(i, sm.mesh.positions[idx[2]]);
-      const SceneMesh::FlatFrame& flat = sm.flatFrames[primID];
-      v.geometricNormal.set(i, flat.geometricNormal);
-      ns.set(i, flat.shadingNormal);
-      tangent.set(i, flat.tangent);
-      u[i] = hits.u[i], w[i] = hits.v[i];
+      v.general[i] = -1;
+      const Material& material = t_.scene_->material(materialIndex);
+      const Bsdf& bsdf =
+          material.uniformBsdf
+              ? *material.uniformBsdf
+              : texturedBsdf_[size_t(i)].emplace(t_.scene_->materialPoint(si[size_t(i)]));
+      v.bsdf[size_t(i)] = &bsdf;
+      v.albedo.set(i, bsdf.albedo());
+      v.transmissive[i] = bsdf.hasTransmission() ? -1 : 0;
+      v.specular[i] = bsdf.isPurelySpecular() ? -1 : 0;
     }
     const Float b0 = 1.0f - u - w;
-    v.position = L::select(smooth, p0, p0 * b0 + p1 * u + p2 * w);
+    v.position = L::select(full, p0, p0 * b0 + p1 * u + p2 * w);
     v.positionError =
-        L::select(smooth, v.positionError, barycentricPositionError(p0, p1, p2, b0, u, w));
+        L::select(full, v.positionError, barycentricPositionError(p0, p1, p2, b0, u, w));
     const Float directionLength = L::length(p_.direction);
-    p_.pathLength = L::select(v.hit, p_.pathLength + distance * directionLength, p_.pathLength);
+    const Float segment = distance * directionLength;
+    p_.pathLength = L::select(v.hit, p_.pathLength + segment, p_.pathLength);
 
-    // Emission found by the previous BSDF sample (or seen directly): rare, so lane by lane.
+    // Attenuation inside a volume, and emission found by the previous BSDF sample (or seen
+    // directly): both rare, so lane by lane.
     const Mask frontFace = L::dot(p_.direction, v.geometricNormal) < 0.0f;
-    const Mask emitting = v.hit & ~L::isBlack(emission) & (frontFace | doubleSided);
+    emission = L::select(frontFace | doubleSided, emission, L::Vec3{});
+    for (int i = 0; i < L::kWidth; ++i) {
+      if (!v.hit[i]) continue;
+      const int volume = p_.volumeMaterial[size_t(i)];
+      if (volume >= 0)
+        p_.beta.set(i, p_.beta.rgbAt(i) *
+                           volumeTransmittance(t_.scene_->material(volume).desc, segment[i]));
+      if (full[i]) emission.set(i, t_.scene_->emitted(si[size_t(i)]));
+    }
+    const Mask emitting = v.hit & ~L::isBlack(emission);
     for (int i = 0; i < L::kWidth && L::any(emitting); ++i) {
       if (!emitting[i]) continue;
       float weight = 1.0f;
       if (!p_.previousDelta[i]) {
-        SurfaceInteraction si = v.interaction[size_t(i)];
-        si.position = v.position.at(i);
-        si.geometricNormal = v.geometricNormal.at(i);
-        si.geomID = hits.geomID[i];
-        si.primID = hits.primID[i];
+        SurfaceInteraction lightPoint = si[size_t(i)];
+        lightPoint.position = v.position.at(i);
+        lightPoint.geometricNormal = v.geometricNormal.at(i);
+        lightPoint.geomID = hits.geomID[i];
+        lightPoint.primID = hits.primID[i];
         weight = powerHeuristic(p_.previousPdf[i],
-                                t_.lights_->pdfAreaLight(p_.previousPosition.at(i), si));
+                                t_.lights_->pdfAreaLight(p_.previousPosition.at(i), lightPoint));
       }
       p_.radiance.set(i, p_.radiance.rgbAt(i) + p_.beta.rgbAt(i) * emission.rgbAt(i) * weight);
     }
 
-    // The shading frame, turned to the side the ray arrives on.
+    // The shading frame: opaque surfaces are shaded from the side the ray arrives on,
+    // transmissive ones keep their outward frame.
     v.wo = -(p_.direction / directionLength);
-    const Mask flip = L::dot(v.wo, v.geometricNormal) < 0.0f;
+    const Mask flip = ~v.transmissive & (L::dot(v.wo, v.geometricNormal) < 0.0f);
     v.ng = L::select(flip, -v.geometricNormal, v.geometricNormal);
     ns = L::select(flip, -ns, ns);
     v.frame = {tangent, L::cross(ns, tangent), ns};
     v.woLocal = v.frame.toLocal(v.wo);
-    const Mask backFacing = v.hit & (v.woLocal.z < 1e-4f);
+    const Mask backFacing = v.hit & ~v.transmissive & (v.woLocal.z < 1e-4f);
     for (int i = 0; i < L::kWidth && L::any(backFacing); ++i) {
       if (!backFacing[i]) continue;
       // A shading normal that faces away from the viewer: shade with the geometric one.
@@ -438,15 +473,26 @@ class LaneTileRenderer {
     return ls;
   }
 
-  // Next-event estimation with the light samples: the Lambertian BSDF, the shadow rays as one
-  // packet, MIS against BSDF sampling. Returns the lanes whose light was unoccluded.
+  // Next-event estimation with the light samples: the BSDF (Lambertian in lanes, others one
+  // by one), the shadow rays as one packet, MIS against BSDF sampling. Returns the lanes whose
+  // light was unoccluded.
   Mask nextEvent(const Vertex& v, const LightLanes& ls) {
     const L::Vec3 wiLocal = v.frame.toLocal(ls.wi);
     const Mask sameSide = (L::dot(ls.wi, v.ng) > 0.0f) == (L::dot(v.wo, v.ng) > 0.0f);
-    const Mask evaluated = grazingSafe(v.woLocal) & grazingSafe(wiLocal) &
-                           ((v.woLocal.z < 0.0f) == (wiLocal.z < 0.0f));
-    const L::Vec3 f = v.f * L::abs(wiLocal.z);
-    const Mask shadow = ls.sampled & sameSide & evaluated & ~L::isBlack(f);
+    Mask evaluated = grazingSafe(v.woLocal) & grazingSafe(wiLocal) &
+                     ((v.woLocal.z < 0.0f) == (wiLocal.z < 0.0f));
+    L::Vec3 f = v.f;
+    Float bsdfPdf = cosineHemispherePdf(L::abs(wiLocal.z));
+    const Mask evaluateOneByOne = v.general & ls.sampled & (v.transmissive | sameSide);
+    for (int i = 0; i < L::kWidth && L::any(evaluateOneByOne); ++i) {
+      if (!evaluateOneByOne[i]) continue;
+      const BsdfEval eval = v.bsdf[size_t(i)]->evaluate(v.woLocal.at(i), wiLocal.at(i));
+      evaluated[i] = -1;
+      f.set(i, eval.f);
+      bsdfPdf[i] = eval.pdf;
+    }
+    const L::Vec3 fCos = f * L::abs(wiLocal.z);
+    const Mask shadow = ls.sampled & (v.transmissive | sameSide) & evaluated & ~L::isBlack(fCos);
     if (!L::any(shadow)) return Mask{};
     const L::Vec3 from = offsetRayOrigin(v.position, v.positionError, v.ng, ls.wi);
     const L::Vec3 to =
@@ -461,30 +507,54 @@ class LaneTileRenderer {
     Mask blockedLanes;
     std::memcpy(&blockedLanes, blocked.value, sizeof blockedLanes);
     const Mask lit = shadow & ~blockedLanes;
-    const Float w = L::select(ls.delta, L::splat(1.0f),
-                              powerHeuristic(ls.pdf, cosineHemispherePdf(L::abs(wiLocal.z))));
-    p_.radiance = L::select(lit, p_.radiance + p_.beta * f * ls.Li * (w / ls.pdf), p_.radiance);
+    const Float w = L::select(ls.delta, L::splat(1.0f), powerHeuristic(ls.pdf, bsdfPdf));
+    p_.radiance = L::select(lit, p_.radiance + p_.beta * fCos * ls.Li * (w / ls.pdf), p_.radiance);
     return lit;
   }
 
-  // Continues the paths by sampling the BSDF (Bsdf::sample for a plain Lambertian), then
-  // Russian roulette. Returns the lanes whose path goes on.
+  // Continues the paths by sampling the BSDF (Bsdf::sample for a plain Lambertian in lanes,
+  // others one by one), then Russian roulette. Returns the lanes whose path goes on.
   Mask scatter(const Vertex& v, const Draws& u, Mask scatters) {
     L::Vec3 wi = sampleCosineHemisphere(u.directionX, u.directionY);
-    const Float pdf = cosineHemispherePdf(wi.z);
+    Float pdf = cosineHemispherePdf(wi.z);
+    L::Vec3 f = v.f;
     Mask continues = scatters & grazingSafe(v.woLocal) & L::isFinite(u.lobe) &
                      L::isFinite(u.directionX) & L::isFinite(u.directionY) & grazingSafe(wi) &
-                     (pdf > 0.0f) & ~L::isBlack(v.f);
+                     (pdf > 0.0f);
     wi.z = L::select(v.woLocal.z < 0.0f, -wi.z, wi.z);
+    Mask delta{}, transmission{};
+    const Mask sampleOneByOne = scatters & v.general;
+    for (int i = 0; i < L::kWidth && L::any(sampleOneByOne); ++i) {
+      if (!sampleOneByOne[i]) continue;
+      const std::optional<BsdfSample> bs =
+          v.bsdf[size_t(i)]->sample(v.woLocal.at(i), u.lobe[i], {u.directionX[i], u.directionY[i]});
+      continues[i] = bs && bs->pdf > 0 ? -1 : 0;
+      if (!continues[i]) continue;
+      wi.set(i, bs->wi), f.set(i, bs->f), pdf[i] = bs->pdf;
+      delta[i] = bs->isDelta ? -1 : 0;
+      transmission[i] = bs->isTransmission ? -1 : 0;
+    }
+    continues &= ~L::isBlack(f);
     const L::Vec3 wiWorld = v.frame.fromLocal(wi);
     // Directions whose side of the geometric surface contradicts the lobe would leak light.
-    continues &= (L::dot(wiWorld, v.ng) > 0.0f) == (L::dot(v.wo, v.ng) > 0.0f);
-    const L::Vec3 beta = p_.beta * (v.f * (L::abs(wi.z) / pdf));
+    const Mask crosses = (L::dot(wiWorld, v.ng) > 0.0f) != (L::dot(v.wo, v.ng) > 0.0f);
+    continues &= crosses == transmission;
+    L::Vec3 beta = p_.beta * (f * (L::abs(wi.z) / pdf));
+    // Entering or leaving a volume (KHR_materials_volume): rare, so lane by lane.
+    for (int i = 0; i < L::kWidth; ++i) {
+      if (!(continues[i] && transmission[i])) continue;
+      const MaterialDesc& m = t_.scene_->material(v.material[size_t(i)]).desc;
+      if (!m.hasVolume) continue;
+      const bool entering = dot(wiWorld.at(i), v.geometricNormal.at(i)) < 0;
+      p_.volumeMaterial[size_t(i)] = entering ? v.material[size_t(i)] : -1;
+      const float eta2 = m.ior * m.ior;
+      p_.etaScale[i] *= entering ? eta2 : 1.0f / eta2;
+    }
     const Mask roulette = continues & (p_.depth + 1 >= t_.settings_.rouletteStartDepth);
-    const Float survive = L::min(L::splat(1.0f), L::maxComponent(beta));
+    const Float survive = L::min(L::splat(1.0f), L::maxComponent(beta * p_.etaScale));
     continues &= ~(roulette & ~(u.roulette < survive));
     p_.beta = L::select(continues, L::select(roulette, beta / survive, beta), p_.beta);
-    p_.previousDelta &= ~continues;
+    p_.previousDelta = L::select(continues, delta, p_.previousDelta);
     p_.previousPdf = L::select(continues, pdf, p_.previousPdf);
     p_.previousPosition = L::select(continues, v.position, p_.previousPosition);
     p_.origin = L::select(continues, offsetRayOrigin(v.position, v.positionError, v.ng, wiWorld),
@@ -508,25 +578,40 @@ class LaneTileRenderer {
   int nextPixel_ = 0;
   Paths p_{};
   Mask alive_{};
+  std::array<std::optional<Bsdf>, L::kWidth> texturedBsdf_;  // where a texture varies the BSDF
 };
 
-std::optional<LaneTracer> LaneTracer::create(const Scene& scene, const LightSet& lights,
-                                             PathTracerSettings settings) {
-  LaneTracer tracer(scene, lights, settings);
-  for (const SceneMesh& sm : scene.data().meshes)
-    if (sm.alphaTested) return std::nullopt;
+LaneTracer::LaneTracer(const Scene& scene, const LightSet& lights, PathTracerSettings settings)
+    : scene_(&scene), lights_(&lights), settings_(settings) {
   for (const Material& material : scene.data().materials) {
     const MaterialDesc& m = material.desc;
     const Bsdf* bsdf = material.uniformBsdf ? &*material.uniformBsdf : nullptr;
-    if (!bsdf || !(bsdf->isPlainLambertian() || bsdf->scattersNothing()) || m.hasVolume ||
-        m.emissiveTexture >= 0 || m.normalTexture >= 0 || material.alphaTested)
-      return std::nullopt;
-    const Vec3f up{0, 0, 1};
-    const Rgb f = bsdf->isPlainLambertian() ? bsdf->evaluate(up, up).f : Rgb(0.0f);
-    tracer.surfaces_.push_back(
-        {bsdf->albedo(), f, m.isEmissive() ? m.emissive : Rgb(0.0f), m.doubleSided});
+    Surface s;
+    s.inLanes =
+        bsdf && (bsdf->isPlainLambertian() || bsdf->scattersNothing()) && m.emissiveTexture < 0;
+    if (s.inLanes) {
+      const Vec3f up{0, 0, 1};
+      s.albedo = bsdf->albedo();
+      s.f = bsdf->isPlainLambertian() ? bsdf->evaluate(up, up).f : Rgb(0.0f);
+      s.emission = m.isEmissive() ? m.emissive : Rgb(0.0f);
+      s.doubleSided = m.doubleSided;
+    }
+    surfaces_.push_back(s);
   }
-  return tracer;
+  double laneArea = 0, area = 0;
+  for (const SceneMesh& sm : scene.data().meshes) {
+    double meshArea = 0;
+    for (uint32_t primID = 0; primID < sm.mesh.triangleCount(); ++primID) {
+      const uint32_t* idx = &sm.mesh.indices[3 * size_t(primID)];
+      const Vec3f p0 = sm.mesh.positions[idx[0]];
+      meshArea +=
+          0.5 *
+          double(length(cross(sm.mesh.positions[idx[1]] - p0, sm.mesh.positions[idx[2]] - p0)));
+    }
+    area += meshArea;
+    if (surfaces_[size_t(sm.mesh.material)].inLanes) laneArea += meshArea;
+  }
+  laneAreaShare_ = area > 0 ? float(laneArea / area) : 0.0f;
 }
 
 void LaneTracer::renderTile(const Tile& tile, const Sampling& sampling, const Camera& camera,

@@ -24,8 +24,8 @@ struct FeatureRecorder {
   }
 };
 
-// Beer–Lambert transmittance through `distance` of a KHR_materials_volume interior:
-// σ = −ln(attenuationColor) / attenuationDistance.
+}  // namespace
+
 Rgb volumeTransmittance(const MaterialDesc& m, float distance) {
   if (!std::isfinite(m.attenuationDistance)) return Rgb(1.0f);
   Rgb t;
@@ -35,8 +35,6 @@ Rgb volumeTransmittance(const MaterialDesc& m, float distance) {
   }
   return t;
 }
-
-}  // namespace
 
 bool PathTracer::unoccluded(const SurfaceInteraction& si, const Vec3f& ng,
                             const LightSample& light) const {

@@ -31,6 +31,10 @@ struct PathTracerSettings {
   int rouletteStartDepth = 3;  // Russian roulette from this bounce on
 };
 
+// Beer–Lambert transmittance through `distance` of a KHR_materials_volume interior:
+// σ = −ln(attenuationColor) / attenuationDistance.
+Rgb volumeTransmittance(const MaterialDesc& m, float distance);
+
 class PathTracer {
  public:
   PathTracer(const Scene& scene, const LightSet& lights, PathTracerSettings settings)

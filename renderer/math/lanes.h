@@ -22,6 +22,9 @@ inline Float splat(float v) {
 inline Float select(Mask m, Float a, Float b) {
   return m ? a : b;
 }
+inline Mask select(Mask m, Mask a, Mask b) {
+  return m ? a : b;
+}
 inline bool any(Mask m) {
   return _mm_movemask_ps(__m128(m)) != 0;
 }

@@ -273,10 +273,10 @@ int main(int argc, char** argv) {
       RenderStats stats;
       Timing time;
     };
-    // The same two renders with the general one-path tracer, for the lane tracer's gain (it
-    // takes this scene: plain Lambertian surfaces and area lights).
+    // The same two renders with the one-path tracer, for the lane tracer's gain where render()
+    // chooses it (scenes mostly of plain Lambertian surfaces, as the Cornell box).
     RenderOptions onePath = options, onePathFullDepth = fullDepth;
-    onePath.lanes = onePathFullDepth.lanes = false;
+    onePath.tracer = onePathFullDepth.tracer = RenderOptions::Tracer::OnePath;
     std::optional<Measured> roulette, noRoulette, onePathRoulette, onePathNoRoulette;
     std::optional<PeerRun> peerRun;
     const auto keepFaster = [&](std::optional<Measured>& best, const RenderOptions& o) {

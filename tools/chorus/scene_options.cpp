@@ -20,6 +20,17 @@ void SceneOptions::addFlags(CLI::App& cmd) {
   cmd.add_option("--max-depth", render.maxDepth, "Maximum bounces per path")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  cmd.add_option_function<std::string>(
+         "--tracer",
+         [this](const std::string& name) {
+           render.tracer = name == "lanes"      ? RenderOptions::Tracer::Lanes
+                           : name == "one-path" ? RenderOptions::Tracer::OnePath
+                                                : RenderOptions::Tracer::Automatic;
+         },
+         "Path tracer: auto (four paths at a time in SIMD lanes when at least half the surface "
+         "area is plain Lambertian), lanes or one-path; the images are the same")
+      ->check(CLI::IsMember({"auto", "lanes", "one-path"}))
+      ->default_str("auto");
   cmd.add_option("--camera", render.camera, "Camera index (glTF camera nodes in order)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);

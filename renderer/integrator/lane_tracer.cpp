@@ -19,7 +19,7 @@ using L::Mask;
 // ray_offset.h's nextFloatUp / nextFloatDown and offsetRayOrigin, lane by lane.
 Float nextFloatUp(Float v) {
   const L::Int bits = L::Int(v);
-  const L::Int stepped = v > 0.0f ? bits + 1 : bits - 1;
+  const L::Int stepped = bits + ((v > 0.0f) & 2) - 1;  // + 1 above zero, − 1 below
   return L::select(v == 0.0f, L::splat(std::numeric_limits<float>::denorm_min()), Float(stepped));
 }
 Float nextFloatDown(Float v) {
@@ -85,7 +85,7 @@ struct Paths {
   Float previousPdf, pathLength;
   Float etaScale;  // radiance scaling by refraction, removed for roulette decisions
   Mask previousDelta;
-  std::array<int, L::kWidth> volumeMaterial;  // the material whose interior the path is in, or −1
+  L::Int volumeMaterial;  // the material whose interior the path is in, or −1
   L::Vec3 previousPosition;
   L::Int depth;
   // Features (PathTracer's FeatureRecorder): set while not locked.
@@ -101,7 +101,7 @@ struct Paths {
     previousPdf[i] = 0;
     pathLength[i] = 0;
     etaScale[i] = 1;
-    volumeMaterial[size_t(i)] = -1;
+    volumeMaterial[i] = -1;
     previousDelta[i] = -1;  // the camera ray counts as a delta event: no MIS on its hit
     previousPosition.set(i, ray.origin);
     depth[i] = 0;
@@ -248,11 +248,11 @@ class LaneTileRenderer {
     Mask ended{};
     for (int i = 0; i < L::kWidth; ++i)
       if (alive_[i] && hits.geomID[i] == HitPacket4::kNoHit) escape(i), ended[i] = -1;
-    const Vertex v = vertex(hits);
+    const Vertex& v = vertex(hits);
     const Mask atMaxDepth = v.hit & (p_.depth >= t_.settings_.maxDepth);
     ended |= atMaxDepth;
     const Mask scatters = v.hit & ~atMaxDepth;
-    const Draws u = draws(scatters, bounceDimensions);
+    const Draws& u = draws(scatters, bounceDimensions);
     const Mask lit = nextEvent(v, sampleLights(v, u, scatters & ~v.specular));
     const Mask lockNow = scatters & ~v.specular & ~p_.locked;
     p_.visibility =
@@ -286,11 +286,12 @@ class LaneTileRenderer {
   // Scene::interaction for the hit lanes (flat Lambertian triangles in lanes, others one by
   // one), the volume attenuation and emission up to there, the shading frame, and the features
   // of paths not yet locked.
-  Vertex vertex(const HitPacket4& hits) {
+  const Vertex& vertex(const HitPacket4& hits) {
     const SceneData& data = t_.scene_->data();
-    Vertex v;
+    Vertex& v = vertex_;
+    v.hit = v.general = v.transmissive = v.specular = Mask{};
     Mask full{}, doubleSided{};  // full: the lane's SurfaceInteraction comes from the scene
-    std::array<SurfaceInteraction, L::kWidth> si;
+    std::array<SurfaceInteraction, L::kWidth>& si = interactions_;
     L::Vec3 p0{}, p1{}, p2{}, ns{}, tangent{}, emission{};
     Float u{}, w{}, distance{};
     for (int i = 0; i < L::kWidth; ++i) {
@@ -330,6 +331,7 @@ class LaneTileRenderer {
         continue;
       }
       v.general[i] = -1;
+      v.f.set(i, Rgb(0.0f));  // no shadow ray unless its Bsdf evaluates to something
       const Material& material = t_.scene_->material(materialIndex);
       const Bsdf& bsdf =
           material.uniformBsdf
@@ -352,12 +354,12 @@ class LaneTileRenderer {
     // directly): both rare, so lane by lane.
     const Mask frontFace = L::dot(p_.direction, v.geometricNormal) < 0.0f;
     emission = L::select(frontFace | doubleSided, emission, L::Vec3{});
-    for (int i = 0; i < L::kWidth; ++i) {
-      if (!v.hit[i]) continue;
-      const int volume = p_.volumeMaterial[size_t(i)];
-      if (volume >= 0)
-        p_.beta.set(i, p_.beta.rgbAt(i) *
-                           volumeTransmittance(t_.scene_->material(volume).desc, segment[i]));
+    const Mask inVolume = v.hit & (p_.volumeMaterial >= 0);
+    for (int i = 0; i < L::kWidth && L::any(inVolume | full); ++i) {
+      if (inVolume[i])
+        p_.beta.set(
+            i, p_.beta.rgbAt(i) *
+                   volumeTransmittance(t_.scene_->material(p_.volumeMaterial[i]).desc, segment[i]));
       if (full[i]) emission.set(i, t_.scene_->emitted(si[size_t(i)]));
     }
     const Mask emitting = v.hit & ~L::isBlack(emission);
@@ -401,8 +403,8 @@ class LaneTileRenderer {
     return v;
   }
 
-  Draws draws(Mask scatters, const std::array<uint32_t, L::kWidth>& bounceDimensions) {
-    Draws u;
+  const Draws& draws(Mask scatters, const std::array<uint32_t, L::kWidth>& bounceDimensions) {
+    Draws& u = draws_;
     for (int i = 0; i < L::kWidth; ++i) {
       if (!scatters[i]) continue;
       const Sampler::BounceDraws d = samplers_[size_t(i)].getBounce(bounceDimensions[size_t(i)]);
@@ -415,8 +417,9 @@ class LaneTileRenderer {
 
   // LightSet::sample for every scattering lane: uniform area lights (the common case) in lanes,
   // any other light through LightSet::sample itself.
-  LightLanes sampleLights(const Vertex& v, const Draws& u, Mask scatters) const {
-    LightLanes ls;
+  const LightLanes& sampleLights(const Vertex& v, const Draws& u, Mask scatters) {
+    LightLanes& ls = lightSamples_;
+    ls.sampled = ls.delta = ls.infinite = Mask{};
     if (t_.lights_->empty()) return ls;
     Float pmf{}, area{};
     L::Vec3 l0{}, l1{}, l2{}, lightLe{};
@@ -541,12 +544,13 @@ class LaneTileRenderer {
     continues &= crosses == transmission;
     L::Vec3 beta = p_.beta * (f * (L::abs(wi.z) / pdf));
     // Entering or leaving a volume (KHR_materials_volume): rare, so lane by lane.
-    for (int i = 0; i < L::kWidth; ++i) {
-      if (!(continues[i] && transmission[i])) continue;
+    const Mask refracts = continues & transmission;
+    for (int i = 0; i < L::kWidth && L::any(refracts); ++i) {
+      if (!refracts[i]) continue;
       const MaterialDesc& m = t_.scene_->material(v.material[size_t(i)]).desc;
       if (!m.hasVolume) continue;
       const bool entering = dot(wiWorld.at(i), v.geometricNormal.at(i)) < 0;
-      p_.volumeMaterial[size_t(i)] = entering ? v.material[size_t(i)] : -1;
+      p_.volumeMaterial[i] = entering ? v.material[size_t(i)] : -1;
       const float eta2 = m.ior * m.ior;
       p_.etaScale[i] *= entering ? eta2 : 1.0f / eta2;
     }
@@ -579,6 +583,12 @@ class LaneTileRenderer {
   Paths p_{};
   Mask alive_{};
   std::array<std::optional<Bsdf>, L::kWidth> texturedBsdf_;  // where a texture varies the BSDF
+  // The current step's stages, kept between steps so that they are not cleared each time (only
+  // their masks are; lanes outside them hold values of earlier steps, never read).
+  Vertex vertex_;
+  std::array<SurfaceInteraction, L::kWidth> interactions_;
+  Draws draws_;
+  LightLanes lightSamples_;
 };
 
 LaneTracer::LaneTracer(const Scene& scene, const LightSet& lights, PathTracerSettings settings)

@@ -123,10 +123,6 @@ struct Paths {
   }
 };
 
-int countLanes(Mask m) {
-  return __builtin_popcount(unsigned(_mm_movemask_ps(__m128(m))));
-}
-
 // A mask as the aligned int array Embree's packet calls take (−1: lane active).
 struct LaneArray {
   alignas(16) int32_t value[L::kWidth];
@@ -243,7 +239,7 @@ class LaneTileRenderer {
     HitPacket4 hits;
     t_.scene_->intersect4(LaneArray(alive_).value, packet(p_.origin, p_.direction, kInfinity),
                           &hits);
-    rays_.closestHit += uint64_t(countLanes(alive_));
+    rays_.closestHit += uint64_t(L::count(alive_));
 
     Mask ended{};
     for (int i = 0; i < L::kWidth; ++i)
@@ -506,7 +502,7 @@ class LaneTileRenderer {
                          packet(from, L::select(ls.infinite, ls.wi, to - from),
                                 L::select(ls.infinite, kInfinity, L::splat(1.0f - kShadowEpsilon))),
                          blocked.value);
-    rays_.shadow += uint64_t(countLanes(shadow));
+    rays_.shadow += uint64_t(L::count(shadow));
     Mask blockedLanes;
     std::memcpy(&blockedLanes, blocked.value, sizeof blockedLanes);
     const Mask lit = shadow & ~blockedLanes;

@@ -3,8 +3,11 @@
 // extensions, so +, −, ×, ÷ and comparisons work lane by lane. Every helper evaluates exactly
 // what its scalar counterpart in vec.h and <algorithm> evaluates, in the same order, so lane
 // results equal scalar results bit for bit (no FMA contraction: the portable target has none).
+#if defined(__SSE__)
 #include <xmmintrin.h>
+#endif
 
+#include <cmath>
 #include <cstdint>
 
 #include "renderer/math/vec.h"
@@ -25,14 +28,29 @@ inline Float select(Mask m, Float a, Float b) {
 inline Mask select(Mask m, Mask a, Mask b) {
   return m ? a : b;
 }
+// Bit i set where lane i is true.
+inline int laneBits(Mask m) {
+#if defined(__SSE__)
+  return _mm_movemask_ps(__m128(m));
+#else
+  return (m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8);
+#endif
+}
 inline bool any(Mask m) {
-  return _mm_movemask_ps(__m128(m)) != 0;
+  return laneBits(m) != 0;
+}
+inline int count(Mask m) {
+  return __builtin_popcount(unsigned(laneBits(m)));
 }
 inline Float abs(Float x) {
   return Float(Int(x) & 0x7fffffff);
 }
 inline Float sqrt(Float x) {
+#if defined(__SSE__)
   return Float(_mm_sqrt_ps(__m128(x)));
+#else
+  return Float{std::sqrt(x[0]), std::sqrt(x[1]), std::sqrt(x[2]), std::sqrt(x[3])};
+#endif
 }
 // std::min(a, b) and std::max(a, b): (b < a) ? b : a and (a < b) ? b : a (NaN and ±0 included).
 inline Float min(Float a, Float b) {

@@ -74,23 +74,25 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
     const int x0 = (tile % tilesX) * kTileSize, y0 = (tile / tilesX) * kTileSize;
     const int x1 = std::min(x0 + kTileSize, resolution.width);
     const int y1 = std::min(y0 + kTileSize, resolution.height);
-    Sampler sampler(options.seed);
     PathTracer::RayCounts tileRays;
     uint64_t tileDropped = 0;
-    if (laneTracer)
+    if (laneTracer) {
       laneTracer->renderTile({x0, y0, x1, y1}, {options.spp, options.splits, options.seed}, camera,
                              film, tileRays, tileDropped);
-    for (int y = y0; y < y1 && !laneTracer; ++y) {
-      for (int x = x0; x < x1; ++x) {
-        PixelAccumulator pixel;
-        for (int i = 0; i < options.spp; ++i) {
-          const int k = i % options.splits;
-          sampler.startPixelSample(x, y, uint32_t(i / options.splits), k);
-          const Vec2f offset = sampler.getPixel2D();
-          const Ray ray = camera.generateRay({float(x) + offset.x, float(y) + offset.y});
-          if (!pixel.add(k, tracer.trace(ray, sampler, tileRays))) ++tileDropped;
+    } else {
+      Sampler sampler(options.seed);
+      for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
+          PixelAccumulator pixel;
+          for (int i = 0; i < options.spp; ++i) {
+            const int k = i % options.splits;
+            sampler.startPixelSample(x, y, uint32_t(i / options.splits), k);
+            const Vec2f offset = sampler.getPixel2D();
+            const Ray ray = camera.generateRay({float(x) + offset.x, float(y) + offset.y});
+            if (!pixel.add(k, tracer.trace(ray, sampler, tileRays))) ++tileDropped;
+          }
+          film.store(x, y, pixel);
         }
-        film.store(x, y, pixel);
       }
     }
     rays += tileRays.closestHit + tileRays.shadow;

@@ -11,6 +11,7 @@
 #include "renderer/scene/gltf_loader.h"
 #include "tests/support/gltf_builder.h"
 #include "tests/support/test_support.h"
+#include "tests/support/tracer_comparison.h"
 
 namespace chorus::render {
 namespace {
@@ -29,37 +30,6 @@ RenderOptions options(int width, int height, int spp, int splits) {
   return o;
 }
 
-bool sameImage(const Image& a, const Image& b) {
-  return a.values().size() == b.values().size() &&
-         std::equal(a.values().begin(), a.values().end(), b.values().begin());
-}
-
-// Renders with lanes and without and expects equal buffers, mean and variance of every
-// quantity of every sub-buffer; returns the scalar render's mean colour for sanity checks.
-double expectLanesEqualScalar(const Scene& scene, RenderOptions o) {
-  o.tracer = RenderOptions::Tracer::OnePath;
-  const RenderResult scalar = render(scene, o);
-  o.tracer = RenderOptions::Tracer::Lanes;
-  const RenderResult lanes = render(scene, o);
-  for (int k = 0; k < o.splits; ++k)
-    for (Quantity q : kAllQuantities) {
-      EXPECT_TRUE(sameImage(scalar.buffers.sub(k).get(q).mean, lanes.buffers.sub(k).get(q).mean))
-          << quantityName(q) << " mean, sub-buffer " << k;
-      EXPECT_TRUE(sameImage(scalar.buffers.sub(k).get(q).varianceOfMean,
-                            lanes.buffers.sub(k).get(q).varianceOfMean))
-          << quantityName(q) << " variance, sub-buffer " << k;
-    }
-  EXPECT_FALSE(scalar.stats.lanes);
-  EXPECT_TRUE(lanes.stats.lanes);
-  EXPECT_EQ(scalar.stats.rays, lanes.stats.rays);
-  EXPECT_EQ(scalar.stats.shadowRays, lanes.stats.shadowRays);
-  EXPECT_EQ(scalar.stats.nanSamplesDropped, lanes.stats.nanSamplesDropped);
-  const auto& v = scalar.buffers.sub(0).color.mean.values();
-  double sum = 0;
-  for (float x : v) sum += double(x);
-  return sum / double(v.size());
-}
-
 Scene loadScene(const std::filesystem::path& path, EnvironmentDesc environment = {}) {
   return buildScene(loadGltf(path), environment);
 }
@@ -67,16 +37,16 @@ Scene loadScene(const std::filesystem::path& path, EnvironmentDesc environment =
 TEST(LaneTracer, CornellBoxBitIdenticalToTheScalarTracer) {
   const Scene scene = loadScene(test::sourceDir() / "scenes/cornell-box.gltf");
   // 37×29: partial tiles, lanes that run out of pixels at different times.
-  const double mean = expectLanesEqualScalar(scene, options(37, 29, 6, 2));
+  const double mean = test::expectTracersAgree(scene, options(37, 29, 6, 2));
   EXPECT_GT(mean, 0.01);  // lit, not an empty comparison
-  expectLanesEqualScalar(scene, options(20, 16, 8, 4));
+  test::expectTracersAgree(scene, options(20, 16, 8, 4));
   // Every path to full depth, and paths cut at the first bounce.
   RenderOptions deep = options(16, 16, 4, 1);
   deep.rouletteStartDepth = 100;
-  expectLanesEqualScalar(scene, deep);
+  test::expectTracersAgree(scene, deep);
   RenderOptions shallow = options(16, 16, 4, 1);
   shallow.maxDepth = 1;
-  expectLanesEqualScalar(scene, shallow);
+  test::expectTracersAgree(scene, shallow);
 }
 
 // Every kind of light and surface the lane tracer takes, in one open room: one- and two-sided
@@ -118,17 +88,17 @@ Scene openRoom(const test::TempDir& dir, EnvironmentDesc environment) {
 TEST(LaneTracer, OpenRoomWithEveryKindOfLightBitIdentical) {
   test::TempDir dir;
   const Scene lit = openRoom(dir, EnvironmentDesc{});
-  EXPECT_GT(expectLanesEqualScalar(lit, options(33, 21, 5, 1)), 0.01);
+  EXPECT_GT(test::expectTracersAgree(lit, options(33, 21, 5, 1)), 0.01);
   const Scene sky = openRoom(dir, EnvironmentDesc::constant(Rgb(0.3f, 0.4f, 0.6f)));
-  expectLanesEqualScalar(sky, options(17, 15, 4, 2));
+  test::expectTracersAgree(sky, options(17, 15, 4, 2));
   // An equirectangular map with a bright band, importance-sampled.
   const int w = 16, h = 8;
   std::vector<float> texels(size_t(w * h * 3));
   for (size_t i = 0; i < texels.size(); ++i) texels[i] = (i / 3) % size_t(w) < 4 ? 5.0f : 0.2f;
   const std::filesystem::path hdr = dir / "env.hdr";
   ASSERT_NE(stbi_write_hdr(hdr.c_str(), w, h, 3, texels.data()), 0);
-  expectLanesEqualScalar(openRoom(dir, environmentFromFile(hdr, 30.0f, 1.0f)),
-                         options(17, 15, 4, 4));
+  test::expectTracersAgree(openRoom(dir, environmentFromFile(hdr, 30.0f, 1.0f)),
+                           options(17, 15, 4, 4));
 }
 
 // Surfaces the lanes hand to their Bsdf one by one: glass with a volume, smooth and rough
@@ -136,10 +106,10 @@ TEST(LaneTracer, OpenRoomWithEveryKindOfLightBitIdentical) {
 // own scenes), and alpha-masked, textured-emission and glossy surfaces in lanes next to
 // Lambertian ones.
 TEST(LaneTracer, EveryOtherMaterialBitIdentical) {
-  expectLanesEqualScalar(loadScene(test::sourceDir() / "scenes/glass-and-metal.gltf"),
-                         options(29, 23, 6, 2));
-  expectLanesEqualScalar(loadScene(test::sourceDir() / "scenes/punctual-lights.gltf"),
-                         options(29, 23, 6, 4));
+  test::expectTracersAgree(loadScene(test::sourceDir() / "scenes/glass-and-metal.gltf"),
+                           options(29, 23, 6, 2));
+  test::expectTracersAgree(loadScene(test::sourceDir() / "scenes/punctual-lights.gltf"),
+                           options(29, 23, 6, 4));
 
   test::TempDir dir;
   GltfBuilder b;
@@ -174,7 +144,7 @@ TEST(LaneTracer, EveryOtherMaterialBitIdentical) {
       b.addCamera({{"type", "perspective"}, {"perspective", {{"yfov", 1.1}, {"znear", 0.01}}}});
   b.addNode({{"camera", cam}, {"translation", {0, 1.2, 3}}, {"rotation", {-0.17, 0, 0, 0.985}}});
   b.writeGltf(dir / "mixed.gltf");
-  EXPECT_GT(expectLanesEqualScalar(
+  EXPECT_GT(test::expectTracersAgree(
                 loadScene(dir / "mixed.gltf", EnvironmentDesc::constant(Rgb(0.2f, 0.2f, 0.3f))),
                 options(31, 19, 6, 2)),
             0.01);

@@ -1,6 +1,7 @@
 // Every real glTF scene in ../shared/scenes loads and renders at a small size: finite output,
-// something visible, no warnings beyond the documented unsupported extensions. Scenes without
-// lights of their own (per the folder's README) are lit by its HDR environments.
+// something visible, no warnings beyond the documented unsupported extensions, and the same
+// bits from both path tracers. Scenes without lights of their own (per the folder's README) are
+// lit by its HDR environments.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include "renderer/render.h"
 #include "renderer/scene/gltf_loader.h"
 #include "tests/support/test_support.h"
+#include "tests/support/tracer_comparison.h"
 
 namespace chorus::render {
 namespace {
@@ -64,6 +66,22 @@ TEST_P(SharedScenes, LoadsAndRendersFinite) {
   for (float v : full.color.mean.values()) sum += v;
   EXPECT_GT(sum, 0.0) << "black image";
   EXPECT_EQ(r.buffers.sub(1).sampleCount.at(r.stats.width / 2, 20, 0), 4.0f);
+}
+
+// The lane tracer (forced: `auto` keeps these scenes on the one-path tracer) renders the same
+// bits on real content: textures, normal maps, alpha masks, glass volumes, smooth normals,
+// environment maps.
+TEST_P(SharedScenes, LaneTracerRendersTheSameBits) {
+  CHORUS_REQUIRE_SHARED(shared);
+  const SharedScene& s = GetParam();
+  EnvironmentDesc env;
+  if (s.environment) env = environmentFromFile(shared / "scenes" / "_environments" / s.environment);
+  const Scene scene = buildScene(loadGltf(shared / "scenes" / s.file), env);
+  RenderOptions o;
+  o.height = 24;
+  o.spp = 4;
+  o.splits = 2;
+  EXPECT_GT(test::expectTracersAgree(scene, o), 0.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Shared, SharedScenes, ::testing::ValuesIn(sharedScenes()),

@@ -338,10 +338,13 @@ class LaneTileRenderer {
       v.transmissive[i] = bsdf.hasTransmission() ? -1 : 0;
       v.specular[i] = bsdf.isPurelySpecular() ? -1 : 0;
     }
-    const Float b0 = 1.0f - u - w;
-    v.position = L::select(full, p0, p0 * b0 + p1 * u + p2 * w);
-    v.positionError =
-        L::select(full, v.positionError, barycentricPositionError(p0, p1, p2, b0, u, w));
+    v.position = p0;
+    if (L::any(v.hit & ~full)) {  // some lane on a flat Lambertian triangle
+      const Float b0 = 1.0f - u - w;
+      v.position = L::select(full, p0, p0 * b0 + p1 * u + p2 * w);
+      v.positionError =
+          L::select(full, v.positionError, barycentricPositionError(p0, p1, p2, b0, u, w));
+    }
     const Float directionLength = L::length(p_.direction);
     const Float segment = distance * directionLength;
     p_.pathLength = L::select(v.hit, p_.pathLength + segment, p_.pathLength);
@@ -514,13 +517,18 @@ class LaneTileRenderer {
   // Continues the paths by sampling the BSDF (Bsdf::sample for a plain Lambertian in lanes,
   // others one by one), then Russian roulette. Returns the lanes whose path goes on.
   Mask scatter(const Vertex& v, const Draws& u, Mask scatters) {
-    L::Vec3 wi = sampleCosineHemisphere(u.directionX, u.directionY);
-    Float pdf = cosineHemispherePdf(wi.z);
+    L::Vec3 wi{};
+    Float pdf{};
     L::Vec3 f = v.f;
-    Mask continues = scatters & grazingSafe(v.woLocal) & L::isFinite(u.lobe) &
-                     L::isFinite(u.directionX) & L::isFinite(u.directionY) & grazingSafe(wi) &
-                     (pdf > 0.0f);
-    wi.z = L::select(v.woLocal.z < 0.0f, -wi.z, wi.z);
+    Mask continues{};
+    if (L::any(scatters & ~v.general)) {  // some lane on a Lambertian surface
+      wi = sampleCosineHemisphere(u.directionX, u.directionY);
+      pdf = cosineHemispherePdf(wi.z);
+      continues = scatters & grazingSafe(v.woLocal) & L::isFinite(u.lobe) &
+                  L::isFinite(u.directionX) & L::isFinite(u.directionY) & grazingSafe(wi) &
+                  (pdf > 0.0f);
+      wi.z = L::select(v.woLocal.z < 0.0f, -wi.z, wi.z);
+    }
     Mask delta{}, transmission{};
     const Mask sampleOneByOne = scatters & v.general;
     for (int i = 0; i < L::kWidth && L::any(sampleOneByOne); ++i) {

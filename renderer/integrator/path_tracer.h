@@ -17,6 +17,9 @@
 // white, so dividing by albedo leaves the background unchanged), normal = 0, depth = 0,
 // visibility = 1. Paths that end inside a specular chain (absorbed, roulette, maximum depth)
 // keep the last specular vertex's albedo, normal and depth, with visibility 0.
+//
+// LaneTracer (lane_tracer.h) repeats trace() for four paths at a time, operation for operation:
+// a change here must be made there too (lane_tracer_test compares the two bit for bit).
 #include <cstdint>
 
 #include "renderer/integrator/film.h"

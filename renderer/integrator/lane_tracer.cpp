@@ -425,12 +425,11 @@ class LaneTileRenderer {
     Mask inLanes{}, doubleSided{};
     for (int i = 0; i < L::kWidth; ++i) {
       if (!scatters[i]) continue;
-      float choicePmf = 0;
-      const LightSet::AreaLight* light = t_.lights_->pickLight(u.light[i], &choicePmf);
-      if (!(choicePmf > 0)) continue;
-      if (light) {
+      const LightSet::Pick pick = t_.lights_->pick(u.light[i]);
+      if (!(pick.pmf > 0)) continue;
+      if (const LightSet::AreaLight* light = pick.uniformArea) {
         inLanes[i] = -1;
-        pmf[i] = choicePmf;
+        pmf[i] = pick.pmf;
         area[i] = light->area;
         l0.set(i, light->p0), l1.set(i, light->p1), l2.set(i, light->p2);
         ls.nLight.set(i, light->normal);
@@ -439,7 +438,7 @@ class LaneTileRenderer {
         continue;
       }
       const std::optional<LightSample> s =
-          t_.lights_->sample(v.position.at(i), u.light[i], {u.lightX[i], u.lightY[i]});
+          t_.lights_->sample(v.position.at(i), pick, {u.lightX[i], u.lightY[i]});
       if (!s) continue;
       ls.sampled[i] = -1;
       ls.delta[i] = s->isDelta ? -1 : 0;

@@ -114,12 +114,20 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene), environment_(scene.envi
   choice_ = AliasTable(power);
 }
 
-std::optional<LightSample> LightSet::sample(const Vec3f& ref, float uChoice, Vec2f u) const {
-  if (lights_.empty()) return std::nullopt;
-  float pmf = 0;
-  const int index = choice_.sample(uChoice, &pmf);
-  if (!(pmf > 0)) return std::nullopt;
-  const LightRef light = lights_[size_t(index)];
+LightSet::Pick LightSet::pick(float uChoice) const {
+  Pick p;
+  if (lights_.empty()) return p;
+  p.index = choice_.sample(uChoice, &p.pmf);
+  const LightRef light = lights_[size_t(p.index)];
+  if (light.kind == Kind::Area && areaLights_[light.index].uniform)
+    p.uniformArea = &areaLights_[light.index];
+  return p;
+}
+
+std::optional<LightSample> LightSet::sample(const Vec3f& ref, const Pick& pick, Vec2f u) const {
+  if (!(pick.pmf > 0)) return std::nullopt;
+  const float pmf = pick.pmf;
+  const LightRef light = lights_[size_t(pick.index)];
   // Filled in place and returned as the one named object (no copies of the ~70-byte sample).
   std::optional<LightSample> s(std::in_place);
   bool found = false;

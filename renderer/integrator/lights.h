@@ -30,18 +30,6 @@ class LightSet {
 
   bool empty() const { return lights_.empty(); }
 
-  // Picks a light with uChoice and a point or direction on it with u.
-  std::optional<LightSample> sample(const Vec3f& refPosition, float uChoice, Vec2f u) const;
-
-  // The pdf sample() would have for reaching emissive triangle `lightPoint` from refPosition
-  // (solid angle, including the choice probability): the MIS weight of a BSDF-sampled hit.
-  float pdfAreaLight(const Vec3f& refPosition, const SurfaceInteraction& lightPoint) const;
-  // What a ray escaping in direction `direction` (unit) receives from the environment, and
-  // when withPdf, likewise the pdf of sampling that direction (0 where the radiance is black).
-  EnvironmentLight::Arrival environmentArrival(const Vec3f& direction, bool withPdf) const;
-
-  size_t areaLightCount() const { return areaLights_.size(); }
-
   struct AreaLight {
     uint32_t geomID = 0, primID = 0;
     float area = 0;
@@ -53,13 +41,30 @@ class LightSet {
     Vec3f normal;
     Rgb Le;
   };
+  // The light uChoice selects (alias table by power) and its probability; `uniformArea` is set
+  // when it is a uniform area light, whose sampling the lane tracer repeats in SIMD lanes.
+  struct Pick {
+    int index = 0;
+    float pmf = 0;
+    const AreaLight* uniformArea = nullptr;
+  };
+  Pick pick(float uChoice) const;
 
-  // The light sample() picks with uChoice, and its probability; the light itself when it is a
-  // uniform area light (whose sampling the lane tracer repeats in SIMD lanes), else null.
-  const AreaLight* pickLight(float uChoice, float* pmf) const {
-    const size_t index = size_t(choice_.sample(uChoice, pmf));
-    return index < areaLights_.size() && areaLights_[index].uniform ? &areaLights_[index] : nullptr;
+  // Picks a light with uChoice and a point or direction on it with u (nothing where the pick's
+  // probability is 0 or the sample carries no light).
+  std::optional<LightSample> sample(const Vec3f& refPosition, float uChoice, Vec2f u) const {
+    return sample(refPosition, pick(uChoice), u);
   }
+  std::optional<LightSample> sample(const Vec3f& refPosition, const Pick& pick, Vec2f u) const;
+
+  // The pdf sample() would have for reaching emissive triangle `lightPoint` from refPosition
+  // (solid angle, including the choice probability): the MIS weight of a BSDF-sampled hit.
+  float pdfAreaLight(const Vec3f& refPosition, const SurfaceInteraction& lightPoint) const;
+  // What a ray escaping in direction `direction` (unit) receives from the environment, and
+  // when withPdf, likewise the pdf of sampling that direction (0 where the radiance is black).
+  EnvironmentLight::Arrival environmentArrival(const Vec3f& direction, bool withPdf) const;
+
+  size_t areaLightCount() const { return areaLights_.size(); }
 
  private:
   enum class Kind : uint8_t { Area, Punctual, Environment };

@@ -85,11 +85,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
         for (int x = x0; x < x1; ++x) {
           PixelAccumulator pixel;
           for (int i = 0; i < options.spp; ++i) {
-            const int k = i % options.splits;
-            sampler.startPixelSample(x, y, uint32_t(i / options.splits), k);
-            const Vec2f offset = sampler.getPixel2D();
-            const Ray ray = camera.generateRay({float(x) + offset.x, float(y) + offset.y});
-            if (!pixel.add(k, tracer.trace(ray, sampler, tileRays))) ++tileDropped;
+            const Ray ray = startPixelSample(sampler, camera, x, y, i, options.splits);
+            if (!pixel.add(i % options.splits, tracer.trace(ray, sampler, tileRays))) ++tileDropped;
           }
           film.store(x, y, pixel);
         }

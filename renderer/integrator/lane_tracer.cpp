@@ -197,12 +197,9 @@ class LaneTileRenderer {
   };
 
   void startSample(int i) {
-    Lane& l = lanes_[size_t(i)];
-    Sampler& sampler = samplers_[size_t(i)];
-    sampler.startPixelSample(l.x, l.y, uint32_t(l.sample / sampling_.splits),
-                             l.sample % sampling_.splits);
-    const Vec2f offset = sampler.getPixel2D();
-    p_.start(i, camera_.generateRay({float(l.x) + offset.x, float(l.y) + offset.y}));
+    const Lane& l = lanes_[size_t(i)];
+    p_.start(i,
+             startPixelSample(samplers_[size_t(i)], camera_, l.x, l.y, l.sample, sampling_.splits));
   }
 
   void takePixel(int i) {

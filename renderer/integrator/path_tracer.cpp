@@ -26,6 +26,12 @@ struct FeatureRecorder {
 
 }  // namespace
 
+Ray startPixelSample(Sampler& sampler, const Camera& camera, int x, int y, int sample, int splits) {
+  sampler.startPixelSample(x, y, uint32_t(sample / splits), sample % splits);
+  const Vec2f offset = sampler.getPixel2D();
+  return camera.generateRay({float(x) + offset.x, float(y) + offset.y});
+}
+
 Rgb volumeTransmittance(const MaterialDesc& m, float distance) {
   if (!std::isfinite(m.attenuationDistance)) return Rgb(1.0f);
   Rgb t;

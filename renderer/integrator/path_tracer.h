@@ -22,6 +22,7 @@
 // a change here must be made there too (lane_tracer_test compares the two bit for bit).
 #include <cstdint>
 
+#include "renderer/integrator/camera.h"
 #include "renderer/integrator/film.h"
 #include "renderer/integrator/lights.h"
 #include "renderer/sampling/sampler.h"
@@ -33,6 +34,10 @@ struct PathTracerSettings {
   int maxDepth = 8;            // maximum number of scattering events on a path
   int rouletteStartDepth = 3;  // Russian roulette from this bounce on
 };
+
+// Starts sample `sample` of pixel (x, y) — sub-buffer sample mod splits, index sample / splits
+// in it — and returns its camera ray through the position in the pixel drawn first.
+Ray startPixelSample(Sampler& sampler, const Camera& camera, int x, int y, int sample, int splits);
 
 // Beer–Lambert transmittance through `distance` of a KHR_materials_volume interior:
 // σ = −ln(attenuationColor) / attenuationDistance.

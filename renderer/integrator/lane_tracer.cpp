@@ -350,20 +350,21 @@ class LaneTileRenderer {
     // directly): both rare, so lane by lane.
     const Mask frontFace = L::dot(p_.direction, v.geometricNormal) < 0.0f;
     emission = L::select(frontFace | doubleSided, emission, L::Vec3{});
+    // Lanes whose Surface has no emission of its own (general ones) ask the scene.
     const Mask inVolume = v.hit & (p_.volumeMaterial >= 0);
-    for (int i = 0; i < L::kWidth && L::any(inVolume | full); ++i) {
+    for (int i = 0; i < L::kWidth && L::any(inVolume | v.general); ++i) {
       if (inVolume[i])
         p_.beta.set(
             i, p_.beta.rgbAt(i) *
                    volumeTransmittance(t_.scene_->material(p_.volumeMaterial[i]).desc, segment[i]));
-      if (full[i]) emission.set(i, t_.scene_->emitted(si[size_t(i)]));
+      if (v.general[i]) emission.set(i, t_.scene_->emitted(si[size_t(i)]));
     }
     const Mask emitting = v.hit & ~L::isBlack(emission);
     for (int i = 0; i < L::kWidth && L::any(emitting); ++i) {
       if (!emitting[i]) continue;
       float weight = 1.0f;
       if (!p_.previousDelta[i]) {
-        SurfaceInteraction lightPoint = si[size_t(i)];
+        SurfaceInteraction lightPoint;  // what pdfAreaLight reads
         lightPoint.position = v.position.at(i);
         lightPoint.geometricNormal = v.geometricNormal.at(i);
         lightPoint.geomID = hits.geomID[i];

@@ -36,6 +36,12 @@ const std::vector<SharedScene>& sharedScenes() {
   return scenes;
 }
 
+// The HDR environment a scene without lights of its own is lit by (none for the others).
+EnvironmentDesc environmentOf(const std::filesystem::path& shared, const SharedScene& s) {
+  if (!s.environment) return {};
+  return environmentFromFile(shared / "scenes" / "_environments" / s.environment);
+}
+
 class SharedScenes : public ::testing::TestWithParam<SharedScene> {};
 
 TEST_P(SharedScenes, LoadsAndRendersFinite) {
@@ -45,9 +51,7 @@ TEST_P(SharedScenes, LoadsAndRendersFinite) {
   ASSERT_TRUE(std::filesystem::exists(file)) << file;
   SceneDesc desc = loadGltf(file);
   EXPECT_EQ(desc.warnings, s.expectedWarnings);
-  EnvironmentDesc env;
-  if (s.environment) env = environmentFromFile(shared / "scenes" / "_environments" / s.environment);
-  const Scene scene = buildScene(std::move(desc), env);
+  const Scene scene = buildScene(std::move(desc), environmentOf(shared, s));
   EXPECT_FALSE(scene.usesDefaultEnvironment());
 
   RenderOptions o;
@@ -74,9 +78,7 @@ TEST_P(SharedScenes, LoadsAndRendersFinite) {
 TEST_P(SharedScenes, LaneTracerRendersTheSameBits) {
   CHORUS_REQUIRE_SHARED(shared);
   const SharedScene& s = GetParam();
-  EnvironmentDesc env;
-  if (s.environment) env = environmentFromFile(shared / "scenes" / "_environments" / s.environment);
-  const Scene scene = buildScene(loadGltf(shared / "scenes" / s.file), env);
+  const Scene scene = buildScene(loadGltf(shared / "scenes" / s.file), environmentOf(shared, s));
   RenderOptions o;
   o.height = 24;
   o.spp = 4;

@@ -1,5 +1,6 @@
 #include "renderer/integrator/lane_tracer.h"
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <limits>
@@ -609,6 +610,10 @@ LaneTracer::LaneTracer(const Scene& scene, const LightSet& lights, PathTracerSet
     }
     surfaces_.push_back(s);
   }
+  // The share over the triangles' areas; none of them needs measuring when no surface is
+  // shaded in lanes (most published models: render() then stays with one path at a time).
+  if (std::none_of(surfaces_.begin(), surfaces_.end(), [](const Surface& s) { return s.inLanes; }))
+    return;
   double laneArea = 0, area = 0;
   for (const SceneMesh& sm : scene.data().meshes) {
     double meshArea = 0;

@@ -56,7 +56,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
   if (options.tracer != RenderOptions::Tracer::OnePath) {
     laneTracer.emplace(scene, lights, settings);
     if (options.tracer == RenderOptions::Tracer::Automatic &&
-        laneTracer->laneAreaShare() < LaneTracer::kWorthwhileAreaShare)
+        laneTracer->untexturedAreaShare() < LaneTracer::kWorthwhileAreaShare)
       laneTracer.reset();
   }
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);

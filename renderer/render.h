@@ -33,7 +33,7 @@ struct RenderOptions {
   int camera = 0;  // index into the scene's cameras (0 with none: frame the bounds)
   // Which path tracer renders (the images are bit-identical; only the speed differs):
   // Automatic takes LaneTracer (four paths in SIMD lanes) when at least half the scene's surface
-  // area is shaded in lanes (plain Lambertian materials), else PathTracer one path at a time.
+  // area has a material no texture varies, else PathTracer one path at a time.
   enum class Tracer { Automatic, Lanes, OnePath };
   Tracer tracer = Tracer::Automatic;
 };

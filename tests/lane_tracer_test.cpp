@@ -150,16 +150,18 @@ TEST(LaneTracer, EveryOtherMaterialBitIdentical) {
             0.01);
 }
 
-// Automatic picks the lanes where at least half the surface area is plain Lambertian.
-TEST(LaneTracer, AutomaticChoiceFollowsTheLambertianAreaShare) {
+// Automatic picks the lanes where at least half the surface area is untextured (here a glTF
+// default material, Lambertian under a specular layer; the other quad has a base colour texture).
+TEST(LaneTracer, AutomaticChoiceFollowsTheUntexturedAreaShare) {
   test::TempDir dir;
-  const auto twoQuads = [&](float lambertianSide, float metalSide) {
+  const auto twoQuads = [&](float untexturedSide, float texturedSide) {
     GltfBuilder b;
-    const float l = lambertianSide, m = metalSide;
-    b.addQuad({0, 0, 0}, {l, 0, 0}, {l, l, 0}, {0, l, 0},
-              b.addMaterial(test::lambertianMaterial(0.5f, 0.5f, 0.5f)));
-    b.addQuad({0, 0, 1}, {m, 0, 1}, {m, m, 1}, {0, m, 1},
-              b.addMaterial({{"pbrMetallicRoughness", {{"metallicFactor", 1.0}}}}));
+    const float u = untexturedSide, t = texturedSide;
+    b.addQuad({0, 0, 0}, {u, 0, 0}, {u, u, 0}, {0, u, 0},
+              b.addMaterial({{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}}));
+    const int texture = b.addTexture(1, 1, {200, 100, 50, 255});
+    b.addQuad({0, 0, 1}, {t, 0, 1}, {t, t, 1}, {0, t, 1},
+              b.addMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", texture}}}}}}));
     const int cam =
         b.addCamera({{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", 0.01}}}});
     b.addNode({{"camera", cam}, {"translation", {1, 1, 5}}});
@@ -167,7 +169,7 @@ TEST(LaneTracer, AutomaticChoiceFollowsTheLambertianAreaShare) {
     return loadScene(dir / "quads.gltf");
   };
   const auto share = [](const Scene& scene) {
-    return LaneTracer(scene, LightSet(scene), PathTracerSettings{}).laneAreaShare();
+    return LaneTracer(scene, LightSet(scene), PathTracerSettings{}).untexturedAreaShare();
   };
   const auto usesLanes = [](const Scene& scene) {
     return render(scene, options(8, 8, 1, 1)).stats.lanes;
@@ -181,7 +183,9 @@ TEST(LaneTracer, AutomaticChoiceFollowsTheLambertianAreaShare) {
   const Scene cornell = loadScene(test::sourceDir() / "scenes/cornell-box.gltf");
   EXPECT_EQ(share(cornell), 1.0f);
   EXPECT_TRUE(usesLanes(cornell));
+  // Its checkered floor and the normal-mapped brick wall are most of these two scenes' area.
   EXPECT_FALSE(usesLanes(loadScene(test::sourceDir() / "scenes/glass-and-metal.gltf")));
+  EXPECT_FALSE(usesLanes(loadScene(test::sourceDir() / "scenes/punctual-lights.gltf")));
 }
 
 }  // namespace

@@ -610,11 +610,13 @@ LaneTracer::LaneTracer(const Scene& scene, const LightSet& lights, PathTracerSet
     }
     surfaces_.push_back(s);
   }
-  // The share over the triangles' areas; none of them needs measuring when no surface is
-  // shaded in lanes (most published models: render() then stays with one path at a time).
-  if (std::none_of(surfaces_.begin(), surfaces_.end(), [](const Surface& s) { return s.inLanes; }))
-    return;
-  double laneArea = 0, area = 0;
+  // The share over the triangles' areas; none of them needs measuring when every material is
+  // textured (most published models: render() then stays with one path at a time).
+  std::vector<bool> untextured;
+  for (const Material& material : scene.data().materials)
+    untextured.push_back(material.uniformBsdf && material.desc.emissiveTexture < 0);
+  if (std::find(untextured.begin(), untextured.end(), true) == untextured.end()) return;
+  double untexturedArea = 0, area = 0;
   for (const SceneMesh& sm : scene.data().meshes) {
     double meshArea = 0;
     for (uint32_t primID = 0; primID < sm.mesh.triangleCount(); ++primID) {
@@ -625,9 +627,9 @@ LaneTracer::LaneTracer(const Scene& scene, const LightSet& lights, PathTracerSet
           double(length(cross(sm.mesh.positions[idx[1]] - p0, sm.mesh.positions[idx[2]] - p0)));
     }
     area += meshArea;
-    if (surfaces_[size_t(sm.mesh.material)].inLanes) laneArea += meshArea;
+    if (untextured[size_t(sm.mesh.material)]) untexturedArea += meshArea;
   }
-  laneAreaShare_ = area > 0 ? float(laneArea / area) : 0.0f;
+  untexturedAreaShare_ = area > 0 ? float(untexturedArea / area) : 0.0f;
 }
 
 void LaneTracer::renderTile(const Tile& tile, const Sampling& sampling, const Camera& camera,

@@ -30,11 +30,13 @@ class LaneTracer {
     int spp, splits;
     uint64_t seed;
   };
-  // The share of the scene's surface area whose hits are shaded in lanes, and the share from
-  // which the lanes pay: measured on 2026-12-03, a Cornell box with one metal wall (≈ 90 %) renders
-  // 1.2x faster in lanes, one whose white surfaces have a specular layer (≈ 20 %) equally fast,
-  // scenes of textured or layered materials only (0 %) 5-20 % slower.
-  float laneAreaShare() const { return laneAreaShare_; }
+  // The share of the scene's surface area whose BSDF and emission no texture varies, and the
+  // share from which the lanes pay. Measured on 2026-12-04 (256², 32 spp, best of 3): where it is
+  // 1 the lanes render 1.3x (the Cornell box, plain Lambertian) and 1.11x (CornellBox-Bevy, every
+  // surface under a specular layer) as fast as one path at a time; on scenes mostly of textured
+  // materials, where texture lookups and Bsdf set-up take each lane's time and the packets save
+  // little, 0.90-1.02x (TransmissionTest, LightsPunctualLamp, FlightHelmet, punctual-lights).
+  float untexturedAreaShare() const { return untexturedAreaShare_; }
   static constexpr float kWorthwhileAreaShare = 0.5f;
 
   // Renders the tile's pixels into `film`, as the one-path loop of render() would; adds the
@@ -59,7 +61,7 @@ class LaneTracer {
   const LightSet* lights_;
   PathTracerSettings settings_;
   std::vector<Surface> surfaces_;
-  float laneAreaShare_ = 0;
+  float untexturedAreaShare_ = 0;
 };
 
 }  // namespace chorus::render

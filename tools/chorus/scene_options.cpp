@@ -28,7 +28,7 @@ void SceneOptions::addFlags(CLI::App& cmd) {
                                                 : RenderOptions::Tracer::Automatic;
          },
          "Path tracer: auto (four paths at a time in SIMD lanes when at least half the surface "
-         "area is plain Lambertian), lanes or one-path; the images are the same")
+         "area has an untextured material), lanes or one-path; the images are the same")
       ->check(CLI::IsMember({"auto", "lanes", "one-path"}))
       ->default_str("auto");
   cmd.add_option("--camera", render.camera, "Camera index (glTF camera nodes in order)")

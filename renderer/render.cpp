@@ -30,7 +30,7 @@ void validate(const RenderOptions& o) {
   if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");
   if (o.threads < 0) throw Error("--threads must be positive (0 = all cores)");
   if (o.camera < 0) throw Error("--camera must be 0 or more");
-  if (o.rouletteStartDepth < 0) throw Error("rouletteStartDepth must be 0 or more");
+  if (o.rouletteStartDepth < 0) throw Error("--roulette-depth must be 0 or more");
 }
 
 }  // namespace

@@ -37,6 +37,11 @@ std::filesystem::path writeLitScene(const TempDir& dir, bool withLight = true) {
   return path;
 }
 
+json readJson(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  return json::parse(in);
+}
+
 int lineCount(const std::string& s) {
   return int(std::count(s.begin(), s.end(), '\n'));
 }
@@ -95,6 +100,47 @@ TEST(RenderCli, WritesExrPngAndStats) {
     const auto a = onePath.sub(k).color.mean.values(), b = buffers.sub(k).color.mean.values();
     EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end())) << k;
   }
+}
+
+// --roulette-depth: inside a closed box every path bounces until it ends, so the closest-hit
+// rays per sample are 1 + its bounces. Without roulette that is 1 + max depth. Roulette survives
+// with the path throughput, 0.5 per bounce on these albedo-0.5 walls and renormalised to 1 by each
+// survival: from the first bounce on each bounce survives with probability 0.5; from the third,
+// the first two bounces always happen and the third with probability 0.5³.
+TEST(RenderCli, RouletteDepthSetsWhereRussianRouletteStarts) {
+  TempDir dir;
+  test::GltfBuilder b;
+  const int wall = b.addMaterial(test::lambertianMaterial(0.5f, 0.5f, 0.5f));
+  for (int axis = 0; axis < 3; ++axis)  // the six faces of the cube [-2, 2]³
+    for (float side : {-2.0f, 2.0f}) {
+      const auto corner = [&](float u, float v) {
+        float p[3];
+        p[axis] = side, p[(axis + 1) % 3] = u, p[(axis + 2) % 3] = v;
+        return render::Vec3f{p[0], p[1], p[2]};
+      };
+      b.addQuad(corner(-2, -2), corner(2, -2), corner(2, 2), corner(-2, 2), wall);
+    }
+  const int light = b.addPunctualLight({{"type", "point"}, {"intensity", 1}});
+  b.addNode(
+      {{"translation", {0, 1, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", light}}}}}});
+  const int cam =
+      b.addCamera({{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", 0.1}}}});
+  b.addNode({{"camera", cam}});
+  b.writeGltf(dir / "inside.gltf");
+  const auto closestHitRaysPerSample = [&](const char* rouletteDepth) {
+    const auto out = dir / rouletteDepth;
+    const auto r =
+        runChorus({"render", (dir / "inside.gltf").string(), "--width", "16", "--height", "16",
+                   "--spp", "64", "--max-depth", "3", "--roulette-depth", rouletteDepth,
+                   "--denoise", "none", "--quiet", "--out", out.string()});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    const json stats = readJson(out / "stats.json");
+    EXPECT_EQ(stats["roulette_depth"], std::stoi(rouletteDepth));
+    return (stats["rays"].get<double>() - stats["shadow_rays"].get<double>()) / (16 * 16 * 64);
+  };
+  EXPECT_EQ(closestHitRaysPerSample("4"), 4.0);                             // never
+  EXPECT_NEAR(closestHitRaysPerSample("1"), 1 + 0.5 + 0.25 + 0.125, 0.02);  // σ ≈ 0.006
+  EXPECT_NEAR(closestHitRaysPerSample("3"), 3 + 0.125, 0.01);               // σ ≈ 0.002
 }
 
 TEST(RenderCli, QuietPrintsNothingAndNoLightsGetsOneLine) {
@@ -167,11 +213,6 @@ TEST(RenderCli, FailsCleanlyOnBadInput) {
   expectCleanFailure({"render", scene.string(), "--spp", "1", "--width", "4", "--denoise", "none",
                       "--out", (dir / "file").string()},
                      "file", dir / "file");
-}
-
-json readJson(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  return json::parse(in);
 }
 
 // The in-process ensemble gives exactly what `chorus denoise` computes from the written

@@ -64,6 +64,7 @@ nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderStats& s,
   j["splits"] = s.splits;
   j["seed"] = options.seed;
   j["max_depth"] = options.maxDepth;
+  j["roulette_depth"] = options.rouletteStartDepth;
   j["camera"] = options.camera;
   j["threads"] = options.threads;
   j["environment"] = args.sceneOptions.environmentLabel(loaded.scene);

@@ -20,6 +20,11 @@ void SceneOptions::addFlags(CLI::App& cmd) {
   cmd.add_option("--max-depth", render.maxDepth, "Maximum bounces per path")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  cmd.add_option("--roulette-depth", render.rouletteStartDepth,
+                 "Russian roulette from this bounce on (above --max-depth: never; the expected "
+                 "image is the same, only the noise and the time per sample change)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd.add_option_function<std::string>(
          "--tracer",
          [this](const std::string& name) {

@@ -43,23 +43,6 @@ constexpr SpecularAlbedoTerms kSmoothLayerAverage{20.0f / 21.0f, 1.0f / 21.0f};
 
 }  // namespace
 
-// Probabilities of choosing each lobe family in sample(); they sum to 1 (or are all 0 when the
-// material scatters nothing from this direction).
-struct Bsdf::LobeWeights {
-  float diffuse = 0, metal = 0, interface = 0;
-  bool any() const { return diffuse + metal + interface > 0; }
-};
-
-// What every evaluation for one wo shares: wo in the canonical frame (wo.z > 0; a solid seen
-// from inside is mirrored and flagged), the layer albedo at wo, Smith Λ(wo) and the lobe weights.
-struct Bsdf::Context {
-  Vec3f wo;
-  bool flip = false, inside = false;
-  float layerAlbedoO = 0;
-  float lambdaO = 0;
-  LobeWeights weights;
-};
-
 Bsdf::Bsdf(const MaterialPoint& material) : m_(material) {
   m_.baseColor = clamp01(material.baseColor);
   m_.metallic = clamp01(material.metallic);
@@ -132,8 +115,11 @@ float Bsdf::reflectTransmitChoice(const Rgb& fresnel, bool transmits) const {
   return reflect / (reflect + transmit);
 }
 
-Bsdf::Context Bsdf::context(Vec3f wo) const {
-  Context c;
+Bsdf::Outgoing Bsdf::prepare(Vec3f wo) const {
+  Outgoing c;
+  c.given = wo;
+  c.usable = grazingSafe(wo);
+  if (!c.usable) return c;
   c.flip = wo.z < 0;
   c.inside = c.flip && solidTransmission_;
   c.wo = c.flip ? mirrorZ(wo) : wo;
@@ -148,7 +134,7 @@ Bsdf::Context Bsdf::context(Vec3f wo) const {
   return c;
 }
 
-Bsdf::LobeWeights Bsdf::lobeWeights(const Context& c) const {
+Bsdf::LobeWeights Bsdf::lobeWeights(const Outgoing& c) const {
   LobeWeights w;
   const float dielectric = 1.0f - m_.metallic;
   const float baseAverage = m_.baseColor.average();
@@ -185,7 +171,7 @@ Rgb Bsdf::diffuseF(float layerAlbedoO, float cosThetaI) const {
 }
 
 // f and pdf of the non-delta lobes for a canonical wo (c.wo.z > 0) and wi in the same frame.
-BsdfEval Bsdf::evalCanonical(const Context& c, Vec3f wi) const {
+BsdfEval Bsdf::evalCanonical(const Outgoing& c, Vec3f wi) const {
   const Vec3f wo = c.wo;
   const LobeWeights& w = c.weights;
   const float dielectric = 1.0f - m_.metallic;
@@ -255,14 +241,13 @@ BsdfEval Bsdf::evalCanonical(const Context& c, Vec3f wi) const {
   return e;
 }
 
-BsdfEval Bsdf::evaluate(Vec3f wo, Vec3f wi) const {
-  if (!grazingSafe(wo) || !grazingSafe(wi)) return {};
+BsdfEval Bsdf::evaluate(const Outgoing& c, Vec3f wi) const {
+  if (!c.usable || !grazingSafe(wi)) return {};
   if (lambertian_) {
     // evalCanonical's diffuse term, reflection only (the lobe weight is 1, or 0 when black).
-    if ((wo.z < 0) != (wi.z < 0)) return {};
+    if ((c.given.z < 0) != (wi.z < 0)) return {};
     return {m_.baseColor * kInvPi, cosineHemispherePdfSolidAngle(std::abs(wi.z))};
   }
-  const Context c = context(wo);
   return evalCanonical(c, c.flip ? mirrorZ(wi) : wi);
 }
 
@@ -274,8 +259,9 @@ float Bsdf::pdf(Vec3f wo, Vec3f wi) const {
   return evaluate(wo, wi).pdf;
 }
 
-std::optional<BsdfSample> Bsdf::sample(Vec3f woAsGiven, float uLobe, Vec2f u) const {
-  if (!grazingSafe(woAsGiven) || !finiteInputs(woAsGiven, uLobe, u)) return std::nullopt;
+std::optional<BsdfSample> Bsdf::sample(const Outgoing& c, float uLobe, Vec2f u) const {
+  const Vec3f woAsGiven = c.given;
+  if (!c.usable || !finiteInputs(woAsGiven, uLobe, u)) return std::nullopt;
   if (lambertian_) {
     // The diffuse branch below, without the lobe choice and the general evaluation.
     const Vec3f wi = sampleCosineHemisphere(u);
@@ -284,7 +270,6 @@ std::optional<BsdfSample> Bsdf::sample(Vec3f woAsGiven, float uLobe, Vec2f u) co
     if (!(pdf > 0)) return std::nullopt;
     return BsdfSample{m_.baseColor * kInvPi, woAsGiven.z < 0 ? mirrorZ(wi) : wi, pdf, false, false};
   }
-  const Context c = context(woAsGiven);
   const Vec3f wo = c.wo;
   const LobeWeights& w = c.weights;
   if (!w.any()) return std::nullopt;

@@ -72,11 +72,35 @@ class Bsdf {
  public:
   explicit Bsdf(const MaterialPoint& material);
 
+  // Probabilities of choosing each lobe family in sample(); they sum to 1 (or are all 0 when the
+  // material scatters nothing from this direction).
+  struct LobeWeights {
+    float diffuse = 0, metal = 0, interface = 0;
+    bool any() const { return diffuse + metal + interface > 0; }
+  };
+  // What every evaluation and sample for one wo shares: wo in the canonical frame (wo.z > 0; a
+  // solid seen from inside is mirrored and flagged), the layer albedo at wo, Smith Λ(wo) and the
+  // lobe weights. A path vertex prepares it once for its light sample and its BSDF sample.
+  struct Outgoing {
+    Vec3f given;          // wo as passed to prepare()
+    bool usable = false;  // not grazing (else nothing is scattered)
+    Vec3f wo;
+    bool flip = false, inside = false;
+    float layerAlbedoO = 0;
+    float lambdaO = 0;
+    LobeWeights weights;
+  };
+  Outgoing prepare(Vec3f wo) const;
+
   Rgb f(Vec3f wo, Vec3f wi) const;
-  BsdfEval evaluate(Vec3f wo, Vec3f wi) const;  // {f(wo, wi), pdf(wo, wi)}
+  BsdfEval evaluate(Vec3f wo, Vec3f wi) const { return evaluate(prepare(wo), wi); }
+  BsdfEval evaluate(const Outgoing& o, Vec3f wi) const;  // {f(wo, wi), pdf(wo, wi)}
   // uLobe picks the lobe, u samples its direction. Returns nullopt when no direction results
   // (e.g. a microfacet normal that reflects below the surface).
-  std::optional<BsdfSample> sample(Vec3f wo, float uLobe, Vec2f u) const;
+  std::optional<BsdfSample> sample(Vec3f wo, float uLobe, Vec2f u) const {
+    return sample(prepare(wo), uLobe, u);
+  }
+  std::optional<BsdfSample> sample(const Outgoing& o, float uLobe, Vec2f u) const;
   float pdf(Vec3f wo, Vec3f wi) const;
 
   // Every lobe is a delta (smooth glass, smooth metal): features are taken further down the
@@ -97,14 +121,11 @@ class Bsdf {
   Rgb albedo() const { return albedo_; }
 
  private:
-  struct LobeWeights;
-  struct Context;
-  Context context(Vec3f wo) const;
-  LobeWeights lobeWeights(const Context& c) const;
+  LobeWeights lobeWeights(const Outgoing& c) const;
   Rgb dielectricFresnel(float cosTheta, bool inside, bool* transmits) const;
   float layerAlbedo(float cosTheta) const;  // E(μ) of the specular layer, max over channels
   Rgb diffuseF(float layerAlbedoO, float cosThetaI) const;
-  BsdfEval evalCanonical(const Context& c, Vec3f wi) const;
+  BsdfEval evalCanonical(const Outgoing& c, Vec3f wi) const;
   float reflectTransmitChoice(const Rgb& fresnel, bool transmits) const;
 
   MaterialPoint m_;  // clamped to valid ranges

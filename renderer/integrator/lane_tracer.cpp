@@ -151,7 +151,8 @@ struct Vertex {
   L::Vec3 wo{}, woLocal{};
   LaneFrame frame{};
   L::Vec3 albedo{}, f{};  // Bsdf::albedo(), and the Lambertian f (0 for black) outside `general`
-  std::array<const Bsdf*, L::kWidth> bsdf{};  // `general` lanes
+  std::array<const Bsdf*, L::kWidth> bsdf{};         // `general` lanes
+  std::array<Bsdf::Outgoing, L::kWidth> outgoing{};  // `general` lanes that scatter
   std::array<int, L::kWidth> material{};
 };
 
@@ -247,6 +248,7 @@ class LaneTileRenderer {
     ended |= atMaxDepth;
     const Mask scatters = v.hit & ~atMaxDepth;
     const Draws& u = draws(scatters, bounceDimensions);
+    prepareGeneral(scatters);
     const Mask lit = nextEvent(v, sampleLights(v, u, scatters & ~v.specular));
     const Mask lockNow = scatters & ~v.specular & ~p_.locked;
     p_.visibility =
@@ -401,6 +403,14 @@ class LaneTileRenderer {
     return v;
   }
 
+  // What the light sample and the BSDF sample of a general lane share (Bsdf::prepare).
+  void prepareGeneral(Mask scatters) {
+    const Mask general = scatters & vertex_.general;
+    for (int i = 0; i < L::kWidth && L::any(general); ++i)
+      if (general[i])
+        vertex_.outgoing[size_t(i)] = vertex_.bsdf[size_t(i)]->prepare(vertex_.woLocal.at(i));
+  }
+
   const Draws& draws(Mask scatters, const std::array<uint32_t, L::kWidth>& bounceDimensions) {
     Draws& u = draws_;
     for (int i = 0; i < L::kWidth; ++i) {
@@ -486,7 +496,7 @@ class LaneTileRenderer {
     const Mask evaluateOneByOne = v.general & ls.sampled & (v.transmissive | sameSide);
     for (int i = 0; i < L::kWidth && L::any(evaluateOneByOne); ++i) {
       if (!evaluateOneByOne[i]) continue;
-      const BsdfEval eval = v.bsdf[size_t(i)]->evaluate(v.woLocal.at(i), wiLocal.at(i));
+      const BsdfEval eval = v.bsdf[size_t(i)]->evaluate(v.outgoing[size_t(i)], wiLocal.at(i));
       evaluated[i] = -1;
       f.set(i, eval.f);
       bsdfPdf[i] = eval.pdf;
@@ -531,8 +541,8 @@ class LaneTileRenderer {
     const Mask sampleOneByOne = scatters & v.general;
     for (int i = 0; i < L::kWidth && L::any(sampleOneByOne); ++i) {
       if (!sampleOneByOne[i]) continue;
-      const std::optional<BsdfSample> bs =
-          v.bsdf[size_t(i)]->sample(v.woLocal.at(i), u.lobe[i], {u.directionX[i], u.directionY[i]});
+      const std::optional<BsdfSample> bs = v.bsdf[size_t(i)]->sample(
+          v.outgoing[size_t(i)], u.lobe[i], {u.directionX[i], u.directionY[i]});
       continues[i] = bs && bs->pdf > 0 ? -1 : 0;
       if (!continues[i]) continue;
       wi.set(i, bs->wi), f.set(i, bs->f), pdf[i] = bs->pdf;

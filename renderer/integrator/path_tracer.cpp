@@ -131,6 +131,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
       features.record(beta * bsdf.albedo(), faceForward(frame.z, wo), pathLength);
     if (depth >= settings_.maxDepth) break;
     const Sampler::BounceDraws u = sampler.getBounce(bounceDimensions);
+    const Bsdf::Outgoing outgoing = bsdf.prepare(woLocal);
 
     // Next-event estimation.
     bool lightVisible = false;
@@ -139,7 +140,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
         const Vec3f wiLocal = frame.toLocal(ls->wi);
         const bool sameSide = (dot(ls->wi, ng) > 0) == (dot(wo, ng) > 0);
         if (transmissive || sameSide) {
-          const BsdfEval eval = bsdf.evaluate(woLocal, wiLocal);
+          const BsdfEval eval = bsdf.evaluate(outgoing, wiLocal);
           const Rgb f = eval.f * std::abs(wiLocal.z);
           if (!f.isBlack()) {
             ++rays.shadow;
@@ -158,7 +159,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
     }
 
     // Continue the path by sampling the BSDF.
-    const auto bs = bsdf.sample(woLocal, u.lobe, u.direction);
+    const auto bs = bsdf.sample(outgoing, u.lobe, u.direction);
     if (!bs || !(bs->pdf > 0) || bs->f.isBlack()) break;
     const Vec3f wi = frame.fromLocal(bs->wi);
     // Reject directions whose side of the geometric surface contradicts the lobe (possible

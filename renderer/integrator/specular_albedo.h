@@ -5,8 +5,9 @@
 // BSDF uses it to hand the diffuse base exactly the energy the specular layer leaves
 // (albedo scaling, Kelemen & Szirmay-Kalos 2001; Kulla & Conty 2017).
 //
-// The terms come from a table over (μ, roughness) integrated numerically (deterministic; each
-// roughness row once per process, when first needed), interpolated bilinearly. The cosine-weighted
+// The terms come from a table over (μ, roughness) integrated numerically ahead of time
+// (specular_albedo_integral.h; compiled in from specular_albedo_table.inc), interpolated
+// bilinearly. The cosine-weighted
 // average 2 ∫ E(μ) μ dμ is the exact integral of that same interpolant, so the albedo scaling
 // conserves energy exactly with respect to the table.
 namespace chorus::render {

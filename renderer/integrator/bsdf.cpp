@@ -30,8 +30,8 @@ Vec3f mirrorZ(Vec3f v) {
 bool grazingSafe(Vec3f w) {
   return std::abs(w.z) >= kMinBsdfCosine && isFinite(w);
 }
-bool finiteInputs(Vec3f v, float uLobe, Vec2f u) {
-  return isFinite(v) && std::isfinite(uLobe) && std::isfinite(u.x) && std::isfinite(u.y);
+bool finiteDraws(float uLobe, Vec2f u) {
+  return std::isfinite(uLobe) && std::isfinite(u.x) && std::isfinite(u.y);
 }
 
 // Smooth limit of the layer albedo terms: E = F(μ); its average 2∫ (1 − μ)^5 μ dμ = 1/21.
@@ -117,20 +117,19 @@ float Bsdf::reflectTransmitChoice(const Rgb& fresnel, bool transmits) const {
 
 Bsdf::Outgoing Bsdf::prepare(Vec3f wo) const {
   Outgoing c;
-  c.given = wo;
-  c.usable = grazingSafe(wo);
-  if (!c.usable) return c;
-  c.flip = wo.z < 0;
-  c.inside = c.flip && solidTransmission_;
-  c.wo = c.flip ? mirrorZ(wo) : wo;
+  c.usable_ = grazingSafe(wo);
+  if (!c.usable_) return c;
+  c.flip_ = wo.z < 0;
+  c.inside_ = c.flip_ && solidTransmission_;
+  c.wo_ = c.flip_ ? mirrorZ(wo) : wo;
   if (lambertian_) {
     // What the general path below reduces to, without its Fresnel and layer-albedo terms.
-    c.weights.diffuse = 1.0f;
+    c.weights_.diffuse = 1.0f;
     return c;
   }
-  if (!c.inside) c.layerAlbedoO = layerAlbedo(c.wo.z);
-  if (roughReflection_ || (!smooth_ && transmits_)) c.lambdaO = ggx_.lambda(c.wo);
-  c.weights = lobeWeights(c);
+  if (!c.inside_) c.layerAlbedoO_ = layerAlbedo(c.wo_.z);
+  if (roughReflection_ || (!smooth_ && transmits_)) c.lambdaO_ = ggx_.lambda(c.wo_);
+  c.weights_ = lobeWeights(c);
   return c;
 }
 
@@ -138,14 +137,14 @@ Bsdf::LobeWeights Bsdf::lobeWeights(const Outgoing& c) const {
   LobeWeights w;
   const float dielectric = 1.0f - m_.metallic;
   const float baseAverage = m_.baseColor.average();
-  if (!c.inside) {
+  if (!c.inside_) {
     if (1.0f - averageLayerAlbedo_ > kMinBaseEnergy)
-      w.diffuse = dielectric * (1.0f - m_.transmission) * baseAverage * (1.0f - c.layerAlbedoO);
-    w.metal = m_.metallic * schlickFresnel(m_.baseColor, 1.0f, c.wo.z).average();
+      w.diffuse = dielectric * (1.0f - m_.transmission) * baseAverage * (1.0f - c.layerAlbedoO_);
+    w.metal = m_.metallic * schlickFresnel(m_.baseColor, 1.0f, c.wo_.z).average();
     if (!smooth_) w.metal = std::max(w.metal, m_.metallic * kMinRoughLobeWeight);
   }
   bool transmits;
-  const Rgb fresnel = dielectricFresnel(c.wo.z, c.inside, &transmits);
+  const Rgb fresnel = dielectricFresnel(c.wo_.z, c.inside_, &transmits);
   float transmit = transmits ? m_.transmission * baseAverage * (1.0f - fresnel.maxComponent()) : 0;
   if (!smooth_) transmit = std::max(transmit, m_.transmission * baseAverage * kMinRoughLobeWeight);
   w.interface = dielectric * (fresnel.average() + transmit);
@@ -170,32 +169,32 @@ Rgb Bsdf::diffuseF(float layerAlbedoO, float cosThetaI) const {
   return m_.baseColor * scale;
 }
 
-// f and pdf of the non-delta lobes for a canonical wo (c.wo.z > 0) and wi in the same frame.
+// f and pdf of the non-delta lobes for a canonical wo (c.wo_.z > 0) and wi in the same frame.
 BsdfEval Bsdf::evalCanonical(const Outgoing& c, Vec3f wi) const {
-  const Vec3f wo = c.wo;
-  const LobeWeights& w = c.weights;
+  const Vec3f wo = c.wo_;
+  const LobeWeights& w = c.weights_;
   const float dielectric = 1.0f - m_.metallic;
   BsdfEval e;
   if (wi.z > 0) {
-    if (!c.inside) {
-      e.f += diffuseF(c.layerAlbedoO, wi.z);
+    if (!c.inside_) {
+      e.f += diffuseF(c.layerAlbedoO_, wi.z);
       e.pdf += w.diffuse * cosineHemispherePdfSolidAngle(wi.z);
     }
     if (!roughReflection_) return e;
     const Vec3f h = normalize(wo + wi);
     const float cosOH = dot(wo, h);
     const float D = ggx_.D(h);
-    const float microfacet = D / ((1.0f + c.lambdaO + ggx_.lambda(wi)) * 4.0f * wo.z * wi.z);
+    const float microfacet = D / ((1.0f + c.lambdaO_ + ggx_.lambda(wi)) * 4.0f * wo.z * wi.z);
     // Visible-normal pdf / (4 wo·h) = G1(wo) D / (4 wo.z) (Heitz 2018, eq. 17 with the
     // reflection Jacobian).
-    const float reflectPdf = D / ((1.0f + c.lambdaO) * 4.0f * wo.z);
-    if (!c.inside && m_.metallic > 0) {
+    const float reflectPdf = D / ((1.0f + c.lambdaO_) * 4.0f * wo.z);
+    if (!c.inside_ && m_.metallic > 0) {
       e.f += schlickFresnel(m_.baseColor, 1.0f, cosOH) * (m_.metallic * microfacet);
       e.pdf += w.metal * reflectPdf;
     }
     if (dielectric > 0) {
       bool transmits;
-      const Rgb fresnel = dielectricFresnel(cosOH, c.inside, &transmits);
+      const Rgb fresnel = dielectricFresnel(cosOH, c.inside_, &transmits);
       e.f += fresnel * (dielectric * microfacet);
       e.pdf += w.interface * reflectTransmitChoice(fresnel, transmits) * reflectPdf;
     }
@@ -211,30 +210,30 @@ BsdfEval Bsdf::evalCanonical(const Outgoing& c, Vec3f wi) const {
     bool transmits;
     const Rgb fresnel = dielectricFresnel(dot(wo, h), false, &transmits);
     const float D = ggx_.D(h);
-    const float microfacet = D / ((1.0f + c.lambdaO + ggx_.lambda(wr)) * 4.0f * wo.z * wr.z);
+    const float microfacet = D / ((1.0f + c.lambdaO_ + ggx_.lambda(wr)) * 4.0f * wo.z * wr.z);
     e.f = m_.baseColor * (weight * (1.0f - fresnel.maxComponent()) * microfacet);
     e.pdf = w.interface * (1.0f - reflectTransmitChoice(fresnel, transmits)) * D /
-            ((1.0f + c.lambdaO) * 4.0f * wo.z);
+            ((1.0f + c.lambdaO_) * 4.0f * wo.z);
     return e;
   }
   // Walter et al. 2007, eq. 21, with the radiance scaling 1/η² (η = n_wi / n_wo):
   // f = |wi·h| |wo·h| / (|wi.z| wo.z) · D G (1 − F) / (wo·h + η wi·h)².
-  const float eta = c.inside ? 1.0f / eta_ : eta_;
+  const float eta = c.inside_ ? 1.0f / eta_ : eta_;
   const Vec3f halfway = wo + wi * eta;
   if (!(lengthSquared(halfway) > 1e-12f)) return e;
   const Vec3f h = faceForward(normalize(halfway), Vec3f(0, 0, 1));
   const float cosOH = dot(wo, h), cosIH = dot(wi, h);
   if (cosOH <= 0 || cosIH >= 0) return e;
   bool transmits;
-  const Rgb fresnel = dielectricFresnel(cosOH, c.inside, &transmits);
+  const Rgb fresnel = dielectricFresnel(cosOH, c.inside_, &transmits);
   if (!transmits) return e;
   const float denom = cosOH + eta * cosIH;
   const float D = ggx_.D(h);
-  const float G = 1.0f / (1.0f + c.lambdaO + ggx_.lambda(wi));
+  const float G = 1.0f / (1.0f + c.lambdaO_ + ggx_.lambda(wi));
   const float value = D * G * (-cosIH) * cosOH / (wo.z * -wi.z * denom * denom);
   e.f = m_.baseColor * (weight * (1.0f - fresnel.maxComponent()) * value);
   // Visible-normal pdf times dωh/dωi = η² |wi·h| / (wo·h + η wi·h)² (Walter et al. 2007, eq. 17).
-  const float visibleNormalPdf = cosOH * D / ((1.0f + c.lambdaO) * wo.z);
+  const float visibleNormalPdf = cosOH * D / ((1.0f + c.lambdaO_) * wo.z);
   const float jacobian = eta * eta * (-cosIH) / (denom * denom);
   e.pdf = w.interface * (1.0f - reflectTransmitChoice(fresnel, transmits)) * visibleNormalPdf *
           jacobian;
@@ -242,13 +241,13 @@ BsdfEval Bsdf::evalCanonical(const Outgoing& c, Vec3f wi) const {
 }
 
 BsdfEval Bsdf::evaluate(const Outgoing& c, Vec3f wi) const {
-  if (!c.usable || !grazingSafe(wi)) return {};
+  if (!c.usable_ || !grazingSafe(wi)) return {};
   if (lambertian_) {
     // evalCanonical's diffuse term, reflection only (the lobe weight is 1, or 0 when black).
-    if ((c.given.z < 0) != (wi.z < 0)) return {};
+    if (c.flip_ != (wi.z < 0)) return {};
     return {m_.baseColor * kInvPi, cosineHemispherePdfSolidAngle(std::abs(wi.z))};
   }
-  return evalCanonical(c, c.flip ? mirrorZ(wi) : wi);
+  return evalCanonical(c, c.flip_ ? mirrorZ(wi) : wi);
 }
 
 Rgb Bsdf::f(Vec3f wo, Vec3f wi) const {
@@ -260,23 +259,22 @@ float Bsdf::pdf(Vec3f wo, Vec3f wi) const {
 }
 
 std::optional<BsdfSample> Bsdf::sample(const Outgoing& c, float uLobe, Vec2f u) const {
-  const Vec3f woAsGiven = c.given;
-  if (!c.usable || !finiteInputs(woAsGiven, uLobe, u)) return std::nullopt;
+  if (!c.usable_ || !finiteDraws(uLobe, u)) return std::nullopt;
   if (lambertian_) {
     // The diffuse branch below, without the lobe choice and the general evaluation.
     const Vec3f wi = sampleCosineHemisphere(u);
     if (!grazingSafe(wi)) return std::nullopt;
     const float pdf = cosineHemispherePdfSolidAngle(wi.z);
     if (!(pdf > 0)) return std::nullopt;
-    return BsdfSample{m_.baseColor * kInvPi, woAsGiven.z < 0 ? mirrorZ(wi) : wi, pdf, false, false};
+    return BsdfSample{m_.baseColor * kInvPi, c.flip_ ? mirrorZ(wi) : wi, pdf, false, false};
   }
-  const Vec3f wo = c.wo;
-  const LobeWeights& w = c.weights;
+  const Vec3f wo = c.wo_;
+  const LobeWeights& w = c.weights_;
   if (!w.any()) return std::nullopt;
   const auto finish = [&](BsdfSample s) -> std::optional<BsdfSample> {
     if (!(s.pdf > 0) || !s.f.isFinite() || !isFinite(s.wi)) return std::nullopt;
     s.isTransmission = s.wi.z < 0;
-    if (c.flip) s.wi = mirrorZ(s.wi);
+    if (c.flip_) s.wi = mirrorZ(s.wi);
     return s;
   };
   const auto nonDelta = [&](Vec3f wi) -> std::optional<BsdfSample> {
@@ -305,11 +303,11 @@ std::optional<BsdfSample> Bsdf::sample(const Outgoing& c, float uLobe, Vec2f u) 
   const float uChoice =
       std::clamp((uLobe - w.diffuse - w.metal) / w.interface, 0.0f, 0x1.fffffep-1f);
   const float dielectric = 1.0f - m_.metallic;
-  const float eta = c.inside ? 1.0f / eta_ : eta_;
+  const float eta = c.inside_ ? 1.0f / eta_ : eta_;
   const Vec3f h = smooth_ ? Vec3f(0, 0, 1) : ggx_.sampleVisibleNormal(wo, u);
   const float cosOH = dot(wo, h);
   bool transmits;
-  const Rgb fresnel = dielectricFresnel(cosOH, c.inside, &transmits);
+  const Rgb fresnel = dielectricFresnel(cosOH, c.inside_, &transmits);
   const float reflectChoice = reflectTransmitChoice(fresnel, transmits);
   const bool reflection = uChoice < reflectChoice;
 

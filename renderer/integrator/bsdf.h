@@ -69,26 +69,28 @@ struct BsdfEval {
 };
 
 class Bsdf {
- public:
-  explicit Bsdf(const MaterialPoint& material);
-
   // Probabilities of choosing each lobe family in sample(); they sum to 1 (or are all 0 when the
   // material scatters nothing from this direction).
   struct LobeWeights {
     float diffuse = 0, metal = 0, interface = 0;
     bool any() const { return diffuse + metal + interface > 0; }
   };
-  // What every evaluation and sample for one wo shares: wo in the canonical frame (wo.z > 0; a
-  // solid seen from inside is mirrored and flagged), the layer albedo at wo, Smith Λ(wo) and the
-  // lobe weights. A path vertex prepares it once for its light sample and its BSDF sample.
-  struct Outgoing {
-    Vec3f given;          // wo as passed to prepare()
-    bool usable = false;  // not grazing (else nothing is scattered)
-    Vec3f wo;
-    bool flip = false, inside = false;
-    float layerAlbedoO = 0;
-    float lambdaO = 0;
-    LobeWeights weights;
+
+ public:
+  explicit Bsdf(const MaterialPoint& material);
+
+  // What every evaluation and sample for one wo shares (the lobe weights, the layer albedo and
+  // Smith Λ at wo): a path vertex prepares it once for its light sample and its BSDF sample.
+  class Outgoing {
+    friend class Bsdf;
+    bool usable_ = false;  // not grazing (else nothing is scattered)
+    // wo in the canonical frame (wo.z > 0); flip_ says it was mirrored, inside_ that the path
+    // is inside a solid.
+    Vec3f wo_;
+    bool flip_ = false, inside_ = false;
+    float layerAlbedoO_ = 0;
+    float lambdaO_ = 0;
+    LobeWeights weights_;
   };
   Outgoing prepare(Vec3f wo) const;
 

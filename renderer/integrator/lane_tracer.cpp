@@ -609,8 +609,8 @@ LaneTracer::LaneTracer(const Scene& scene, const LightSet& lights, PathTracerSet
     const MaterialDesc& m = material.desc;
     const Bsdf* bsdf = material.uniformBsdf ? &*material.uniformBsdf : nullptr;
     Surface s;
-    s.inLanes =
-        bsdf && (bsdf->isPlainLambertian() || bsdf->scattersNothing()) && m.emissiveTexture < 0;
+    s.untextured = bsdf && m.emissiveTexture < 0;
+    s.inLanes = s.untextured && (bsdf->isPlainLambertian() || bsdf->scattersNothing());
     if (s.inLanes) {
       const Vec3f up{0, 0, 1};
       s.albedo = bsdf->albedo();
@@ -622,10 +622,9 @@ LaneTracer::LaneTracer(const Scene& scene, const LightSet& lights, PathTracerSet
   }
   // The share over the triangles' areas; none of them needs measuring when every material is
   // textured (most published models: render() then stays with one path at a time).
-  std::vector<bool> untextured;
-  for (const Material& material : scene.data().materials)
-    untextured.push_back(material.uniformBsdf && material.desc.emissiveTexture < 0);
-  if (std::find(untextured.begin(), untextured.end(), true) == untextured.end()) return;
+  if (std::none_of(surfaces_.begin(), surfaces_.end(),
+                   [](const Surface& s) { return s.untextured; }))
+    return;
   double untexturedArea = 0, area = 0;
   for (const SceneMesh& sm : scene.data().meshes) {
     double meshArea = 0;
@@ -637,7 +636,7 @@ LaneTracer::LaneTracer(const Scene& scene, const LightSet& lights, PathTracerSet
           double(length(cross(sm.mesh.positions[idx[1]] - p0, sm.mesh.positions[idx[2]] - p0)));
     }
     area += meshArea;
-    if (untextured[size_t(sm.mesh.material)]) untexturedArea += meshArea;
+    if (surfaces_[size_t(sm.mesh.material)].untextured) untexturedArea += meshArea;
   }
   untexturedAreaShare_ = area > 0 ? float(untexturedArea / area) : 0.0f;
 }

@@ -47,9 +47,10 @@ class LaneTracer {
  private:
   friend class LaneTileRenderer;
 
-  // Per material index: whether its hits are shaded in lanes (a plain Lambertian or black BSDF
-  // that no texture varies, untextured emission), and then what they need.
+  // Per material index: whether no texture varies its BSDF and emission, whether its hits are
+  // shaded in lanes (such a material that is plain Lambertian or black), and then what they need.
   struct Surface {
+    bool untextured = false;
     bool inLanes = false;
     Rgb albedo;    // Bsdf::albedo()
     Rgb f;         // the Lambertian BSDF value, baseColor / π (0 for black)

@@ -7,9 +7,8 @@
 //
 // The terms come from a table over (μ, roughness) integrated numerically ahead of time
 // (specular_albedo_integral.h; compiled in from specular_albedo_table.inc), interpolated
-// bilinearly. The cosine-weighted
-// average 2 ∫ E(μ) μ dμ is the exact integral of that same interpolant, so the albedo scaling
-// conserves energy exactly with respect to the table.
+// bilinearly. The cosine-weighted average 2 ∫ E(μ) μ dμ is the exact integral of that same
+// interpolant, so the albedo scaling conserves energy exactly with respect to the table.
 namespace chorus::render {
 
 struct SpecularAlbedoTerms {

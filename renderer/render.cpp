@@ -8,8 +8,9 @@
 #include <mutex>
 #include <string>
 
-#include "denoise/util/error.h"
-#include "denoise/util/stopwatch.h"
+#include "common/error.h"
+#include "common/stopwatch.h"
+#include "common/thread_limit.h"
 #include "renderer/integrator/camera.h"
 #include "renderer/integrator/film.h"
 #include "renderer/integrator/lane_tracer.h"
@@ -28,7 +29,7 @@ void validate(const RenderOptions& o) {
     throw Error("--splits must be 1, 2 or 4 (got " + std::to_string(o.splits) + ")");
   if (o.width < 0 || o.height < 0) throw Error("--width and --height must be positive");
   if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");
-  if (o.threads < 0) throw Error("--threads must be positive (0 = all cores)");
+  checkThreadCount(o.threads);
   if (o.camera < 0) throw Error("--camera must be 0 or more");
   if (o.rouletteStartDepth < 0) throw Error("--roulette-depth must be 0 or more");
 }

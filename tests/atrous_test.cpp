@@ -1,7 +1,7 @@
 // À-trous (Dammertz et al. 2010, SVGF weights) on the synthetic scene: error reduction, sharp
 // feature edges, constant and black images, all buffer parts, determinism, agreement of the
 // SIMD kernels with the scalar one, non-finite inputs and the Tungsten peer buffers.
-#include "denoise/base/atrous.h"
+#include "denoise/base/atrous/atrous.h"
 
 #include <gtest/gtest.h>
 

@@ -9,8 +9,8 @@
 #include <iostream>
 
 #include "denoise/base/registry.h"
-#include "denoise/ensemble/ensemble.h"
 #include "denoise/metrics/metrics.h"
+#include "denoise/pipeline/ensemble.h"
 #include "renderer/render.h"
 #include "renderer/scene/gltf_loader.h"
 #include "tests/support/denoiser_checks.h"

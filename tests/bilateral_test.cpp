@@ -1,11 +1,11 @@
 // The `bilateral` denoiser (joint cross-bilateral with a colour range term) on the synthetic
 // scene: error reduction, sharp feature edges, constant and black images, determinism,
 // non-finite inputs, parameters, and that it is one candidate of the shared filter.
-#include "denoise/base/bilateral.h"
+#include "denoise/base/cross_bilateral/bilateral.h"
 
 #include <gtest/gtest.h>
 
-#include "denoise/base/cross_bilateral.h"
+#include "denoise/base/cross_bilateral/cross_bilateral.h"
 #include "denoise/base/input_planes.h"
 #include "tests/support/denoiser_checks.h"
 #include "tests/support/synthetic_scene.h"

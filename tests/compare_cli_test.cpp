@@ -4,7 +4,7 @@
 
 #include <fstream>
 
-#include "denoise/image/exr_io.h"
+#include "common/image/exr_io.h"
 #include "tests/support/test_support.h"
 
 namespace chorus {

@@ -1,6 +1,6 @@
 // The joint cross-bilateral filter against a naive double-precision evaluation of its formula,
 // its SURE derivative against finite differences, determinism and robustness.
-#include "denoise/base/cross_bilateral.h"
+#include "denoise/base/cross_bilateral/cross_bilateral.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>

@@ -7,13 +7,13 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/image/exr_io.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/buffers_exr.h"
 #include "denoise/ensemble/combiners.h"
 #include "denoise/ensemble/outputs_directory.h"
-#include "denoise/ensemble/synthetic_cases.h"
-#include "denoise/image/exr_io.h"
 #include "denoise/metrics/metrics.h"
+#include "tests/support/synthetic_cases.h"
 #include "tests/support/test_support.h"
 
 namespace chorus {

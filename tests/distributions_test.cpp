@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 #include "tests/support/chi2.h"
 
 namespace chorus::render {

@@ -1,7 +1,7 @@
 // Dual-buffer NL-means (Rousselle et al. 2012) on the synthetic scene: error reduction, every
 // buffer part including single-sample quarters (variance fallback), constant and black images,
 // determinism, non-finite inputs, registry.
-#include "denoise/base/dual_buffer_nlm.h"
+#include "denoise/base/nlm/dual_buffer_nlm.h"
 
 #include <gtest/gtest.h>
 

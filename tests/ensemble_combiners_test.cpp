@@ -9,11 +9,11 @@
 #include <cstdio>
 #include <limits>
 
+#include "common/error.h"
 #include "denoise/ensemble/combiners.h"
-#include "denoise/ensemble/ensemble.h"
-#include "denoise/ensemble/synthetic_cases.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
+#include "denoise/pipeline/ensemble.h"
+#include "tests/support/synthetic_cases.h"
 
 namespace chorus {
 namespace {
@@ -110,7 +110,8 @@ TEST(EnsembleCombiners, NoisyFallbackWhereNoBaseIsPlausible) {
       EXPECT_EQ(on.noisyFallback(px, py, 0), here ? 1.0f : 0.0f);
       for (int ch = 0; ch < 3; ++ch) {
         EXPECT_EQ(on.image(px, py, ch), here ? p.guides.color(px, py, ch) : off.image(px, py, ch));
-        EXPECT_EQ(on.imageA(px, py, ch), here ? p.guides.colorA(px, py, ch) : off.imageA(px, py, ch));
+        EXPECT_EQ(on.imageA(px, py, ch),
+                  here ? p.guides.colorA(px, py, ch) : off.imageA(px, py, ch));
       }
     }
   EXPECT_GT(off.image(x, y, 0), p.guides.color(x, y, 0) + 10.0f);  // the blend kept the blob

@@ -10,9 +10,9 @@
 #include <random>
 #include <vector>
 
+#include "common/error.h"
 #include "denoise/ensemble/mse_estimate.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
 #include "tests/support/test_support.h"
 
 namespace chorus {
@@ -445,7 +445,8 @@ TEST(MseEstimate, FireflyHalfRevealsTheBaseThatPassedItThrough) {
     return t;
   };
   double floorB = 0;
-  for (int c = 0; c < 3; ++c) floorB += std::pow(0.1 * (scale + std::abs(f.guides.colorB(x, y, c))), 2);
+  for (int c = 0; c < 3; ++c)
+    floorB += std::pow(0.1 * (scale + std::abs(f.guides.colorB(x, y, c))), 2);
   const double limit = 64.0 * (std::min(termA(0), termA(1)) + floorB);
   for (double share : {0.99, 1.01}) {
     const double t = std::sqrt(share * limit / 3.0);

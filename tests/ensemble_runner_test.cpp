@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <set>
 
-#include "denoise/ensemble/ensemble.h"
-#include "denoise/ensemble/synthetic_cases.h"
+#include "common/error.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
+#include "denoise/pipeline/ensemble.h"
+#include "tests/support/synthetic_cases.h"
 
 namespace chorus {
 namespace {

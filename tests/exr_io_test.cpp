@@ -9,8 +9,8 @@
 
 #include <fstream>
 
-#include "denoise/image/exr_io.h"
-#include "denoise/util/error.h"
+#include "common/error.h"
+#include "common/image/exr_io.h"
 #include "tests/support/test_support.h"
 
 namespace chorus {

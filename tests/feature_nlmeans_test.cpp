@@ -2,7 +2,7 @@
 // an independent implementation of the same distances: one patch term (plain, patchwise,
 // centre-only denominators), patch plus feature terms, feature terms alone; plus the minimum
 // over terms at a feature step and the non-refined feature mode.
-#include "denoise/base/feature_nlmeans.h"
+#include "denoise/base/filters/feature_nlmeans.h"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <fstream>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 #include "renderer/scene/gltf_loader.h"
 #include "renderer/scene/texture.h"
 #include "tests/support/gltf_builder.h"

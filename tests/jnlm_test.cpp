@@ -1,7 +1,7 @@
 // Joint NL-means on the synthetic scene: error reduction, sharp feature edges, constant and black
 // images, all buffer parts with and without halves, one sample per buffer, determinism,
 // non-finite inputs, parameters.
-#include "denoise/base/joint_nlmeans.h"
+#include "denoise/base/jnlm/joint_nlmeans.h"
 
 #include <gtest/gtest.h>
 

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <random>
 
-#include "denoise/image/exr_io.h"
-#include "denoise/util/error.h"
+#include "common/error.h"
+#include "common/image/exr_io.h"
 #include "renderer/integrator/environment_light.h"
 #include "renderer/integrator/lights.h"
 #include "renderer/scene/scene.h"

@@ -1,8 +1,8 @@
 // Metrics against values computed by hand from their definitions (see metrics.h).
 #include <gtest/gtest.h>
 
+#include "common/error.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
 #include "tests/support/test_support.h"
 
 namespace chorus {

@@ -10,10 +10,10 @@
 
 #include <cstdio>
 
-#include "denoise/base/dual_buffer_nlm.h"
-#include "denoise/base/nfor.h"
+#include "common/image/exr_io.h"
+#include "denoise/base/nfor/nfor.h"
+#include "denoise/base/nlm/dual_buffer_nlm.h"
 #include "denoise/buffers/tungsten_dir.h"
-#include "denoise/image/exr_io.h"
 #include "denoise/metrics/metrics.h"
 #include "tests/support/denoiser_checks.h"
 #include "tests/support/test_support.h"

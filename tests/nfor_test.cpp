@@ -1,7 +1,7 @@
 // NFOR (Bitterli et al. 2016) on the synthetic scene: error reduction, edges, every buffer part
 // including 4 spp quarters (one sample each, so the variance falls back to the two-buffer
 // estimate), constant and black images, determinism, non-finite inputs, registry.
-#include "denoise/base/nfor.h"
+#include "denoise/base/nfor/nfor.h"
 
 #include <gtest/gtest.h>
 

@@ -3,9 +3,9 @@
 #include <gtest/gtest.h>
 #include <stb_image.h>
 
-#include "denoise/image/false_color.h"
-#include "denoise/image/png_io.h"
-#include "denoise/util/error.h"
+#include "common/error.h"
+#include "common/image/false_color.h"
+#include "common/image/png_io.h"
 #include "tests/support/test_support.h"
 
 namespace chorus {

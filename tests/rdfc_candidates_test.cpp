@@ -1,6 +1,6 @@
 // RDFC's candidate filters (rdfc_candidates.h): the derivative against re-runs with a perturbed
 // input, SURE against the true error under Gaussian noise, and the selection in clear cases.
-#include "denoise/base/rdfc_candidates.h"
+#include "denoise/base/rdfc/rdfc_candidates.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <iostream>
 
 #include "denoise/base/buffer_variance.h"
-#include "denoise/base/rdfc.h"
+#include "denoise/base/rdfc/rdfc.h"
 #include "tests/support/gaussian_buffers.h"
 #include "tests/support/synthetic_scene.h"
 

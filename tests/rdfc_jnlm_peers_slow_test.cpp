@@ -6,9 +6,9 @@
 
 #include <iostream>
 
+#include "common/image/exr_io.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/tungsten_dir.h"
-#include "denoise/image/exr_io.h"
 #include "denoise/metrics/metrics.h"
 #include "tests/support/denoiser_checks.h"
 #include "tests/support/test_support.h"

@@ -1,7 +1,7 @@
 // RDFC (Rousselle et al. 2013) on the synthetic scene: error reduction, sharp feature edges,
 // constant and black images, all buffer parts, one sample per buffer, determinism, non-finite
 // inputs, parameters.
-#include "denoise/base/rdfc.h"
+#include "denoise/base/rdfc/rdfc.h"
 
 #include <gtest/gtest.h>
 

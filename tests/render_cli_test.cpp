@@ -6,8 +6,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/image/exr_io.h"
 #include "denoise/buffers/buffers_exr.h"
-#include "denoise/image/exr_io.h"
 #include "tests/support/gltf_builder.h"
 #include "tests/support/test_support.h"
 

@@ -5,7 +5,7 @@
 #include <map>
 #include <random>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 
 #include "denoise/buffers/buffers_exr.h"
 #include "denoise/buffers/sample_buffers.h"
@@ -102,9 +102,9 @@ TEST(SampleBuffers, TwoPartMergeEqualsTheGeneralMerge) {
   const SubBuffer two = merge({&raw.buffers.sub(0), &raw.buffers.sub(1)});
   const SubBuffer general = merge({&raw.buffers.sub(0), &raw.buffers.sub(1), &none});
   for (Quantity q : kAllQuantities)
-    for (const auto& [fast, slow] : {std::pair{&two.get(q).mean, &general.get(q).mean},
-                                     std::pair{&two.get(q).varianceOfMean,
-                                               &general.get(q).varianceOfMean}})
+    for (const auto& [fast, slow] :
+         {std::pair{&two.get(q).mean, &general.get(q).mean},
+          std::pair{&two.get(q).varianceOfMean, &general.get(q).varianceOfMean}})
       for (size_t e = 0; e < fast->size(); ++e)
         ASSERT_EQ(fast->data()[e], slow->data()[e]) << quantityName(q) << " element " << e;
 }

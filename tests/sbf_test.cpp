@@ -1,7 +1,7 @@
 // SBF (Li et al. 2012) on the synthetic scene: error reduction, sharp feature edges, constant
 // and black images, all three buffer parts, determinism, non-finite inputs and the Tungsten
 // peer buffers.
-#include "denoise/base/sbf.h"
+#include "denoise/base/cross_bilateral/sbf.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // many seeds matches the true MSE within 3 standard errors, for a linear filter written here
 // and for the cross-bilateral candidates (with and without the colour range term, whose exact
 // derivative the filter supplies). Dropping the derivative term must fail the same check.
-#include "denoise/base/sure.h"
+#include "denoise/base/filters/sure.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <limits>
 #include <random>
 
-#include "denoise/base/cross_bilateral.h"
+#include "denoise/base/cross_bilateral/cross_bilateral.h"
 #include "denoise/base/input_planes.h"
 
 namespace chorus {

@@ -3,7 +3,7 @@
 
 #include <set>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 #include "tools/sweep/sweep_plan.h"
 
 namespace chorus::sweep {

@@ -2,7 +2,7 @@
 // prints (checked on hand-made rows), SVG plots and the page structure.
 #include <gtest/gtest.h>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 #include "tools/sweep/report_html.h"
 #include "tools/sweep/svg_plot.h"
 #include "tools/sweep/sweep_results.h"

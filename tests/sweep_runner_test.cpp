@@ -7,11 +7,11 @@
 #include <map>
 #include <tuple>
 
+#include "common/error.h"
+#include "common/image/exr_io.h"
 #include "denoise/base/registry.h"
-#include "denoise/ensemble/ensemble.h"
-#include "denoise/image/exr_io.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
+#include "denoise/pipeline/ensemble.h"
 #include "renderer/scene/gltf_loader.h"
 #include "tests/support/test_support.h"
 #include "tests/support/tiny_sweep.h"

@@ -4,9 +4,9 @@
 
 #include <fstream>
 
+#include "common/error.h"
+#include "common/image/exr_io.h"
 #include "denoise/buffers/tungsten_dir.h"
-#include "denoise/image/exr_io.h"
-#include "denoise/util/error.h"
 #include "tests/support/test_support.h"
 
 namespace chorus {

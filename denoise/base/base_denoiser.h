@@ -4,14 +4,14 @@
 // and may be called concurrently on different inputs.
 #include <string>
 
+#include "common/image/image.h"
 #include "denoise/buffers/sample_buffers.h"
-#include "denoise/image/image.h"
 
 namespace chorus {
 
 struct DenoiserRequirements {
-  bool features = false;  // reads albedo / normal / depth / visibility
-  bool halves = false;    // needs DenoiseInput::halves (two independent halves of its input)
+  bool features = false;     // reads albedo / normal / depth / visibility
+  bool halves = false;       // needs DenoiseInput::halves (two independent halves of its input)
   bool readsHalves = false;  // uses DenoiseInput::halves when present (without needing them)
 };
 

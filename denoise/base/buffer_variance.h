@@ -8,7 +8,7 @@
 #include <initializer_list>
 #include <vector>
 
-#include "denoise/image/image.h"
+#include "common/image/image.h"
 
 namespace chorus {
 

@@ -2,7 +2,7 @@
 // Sanitised planar views of a SubBuffer for the filters: NaN/Inf never enter a filter, and
 // "no sample" is turned into "unknown" in a way each filter can handle.
 #include "denoise/buffers/sample_buffers.h"
-#include "denoise/image/planar_image.h"
+#include "denoise/planes/planar_image.h"
 
 namespace chorus {
 

@@ -3,7 +3,7 @@
 #include <charconv>
 #include <sstream>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 
 namespace chorus {
 

@@ -2,15 +2,15 @@
 
 #include <sstream>
 
-#include "denoise/base/atrous.h"
-#include "denoise/base/bilateral.h"
-#include "denoise/base/dual_buffer_nlm.h"
-#include "denoise/base/joint_nlmeans.h"
-#include "denoise/base/nfor.h"
-#include "denoise/base/rdfc.h"
-#include "denoise/base/sbf.h"
+#include "denoise/base/atrous/atrous.h"
+#include "denoise/base/cross_bilateral/bilateral.h"
+#include "denoise/base/cross_bilateral/sbf.h"
+#include "denoise/base/jnlm/joint_nlmeans.h"
+#include "denoise/base/nfor/nfor.h"
+#include "denoise/base/nlm/dual_buffer_nlm.h"
+#include "denoise/base/rdfc/rdfc.h"
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 
 namespace chorus {
 

@@ -9,8 +9,8 @@
 // (X1 − X2)² / 4 that of their average; the estimate is box-smoothed (5×5) because a single
 // squared difference is very noisy. NaN (no sample of a feature in another renderer's buffers)
 // is passed through: the NL-means machinery treats it as "matches nothing".
+#include "common/image/image.h"
 #include "denoise/buffers/sample_buffers.h"
-#include "denoise/image/image.h"
 
 namespace chorus {
 

@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 
 namespace chorus {
 

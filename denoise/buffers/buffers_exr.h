@@ -13,8 +13,8 @@
 #include <filesystem>
 #include <vector>
 
+#include "common/image/exr_io.h"
 #include "denoise/buffers/sample_buffers.h"
-#include "denoise/image/exr_io.h"
 
 namespace chorus {
 

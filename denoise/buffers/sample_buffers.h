@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "denoise/image/image.h"
+#include "common/image/image.h"
 
 namespace chorus {
 

@@ -4,8 +4,8 @@
 
 #include <fstream>
 
-#include "denoise/image/exr_io.h"
-#include "denoise/util/error.h"
+#include "common/error.h"
+#include "common/image/exr_io.h"
 
 namespace chorus {
 namespace fs = std::filesystem;

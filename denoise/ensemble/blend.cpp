@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 
 namespace chorus {
 

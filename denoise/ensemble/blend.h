@@ -4,7 +4,7 @@
 #include <span>
 #include <vector>
 
-#include "denoise/image/image.h"
+#include "common/image/image.h"
 
 namespace chorus {
 

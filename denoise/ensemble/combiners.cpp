@@ -8,10 +8,10 @@
 #include <cmath>
 #include <limits>
 
+#include "common/error.h"
+#include "common/stopwatch.h"
 #include "denoise/ensemble/blend.h"
 #include "denoise/ensemble/pairwise_solver.h"
-#include "denoise/util/error.h"
-#include "denoise/util/stopwatch.h"
 
 namespace chorus {
 namespace {
@@ -151,12 +151,11 @@ std::vector<Image> argminOneHot(const std::vector<Image>& maps,
   return out;
 }
 
-std::vector<const Image*> outputsOf(std::span<const BaseOutputs* const> bases, BufferPart part) {
+// One run of every base: outputsOf(bases, &BaseOutputs::a) are the y_i^A.
+std::vector<const Image*> outputsOf(std::span<const BaseOutputs* const> bases,
+                                    Image BaseOutputs::*run) {
   std::vector<const Image*> images;
-  for (const BaseOutputs* base : bases)
-    images.push_back(part == BufferPart::HalfA   ? &base->a
-                     : part == BufferPart::HalfB ? &base->b
-                                                 : &base->full);
+  for (const BaseOutputs* base : bases) images.push_back(&(base->*run));
   return images;
 }
 
@@ -165,9 +164,9 @@ struct Blends {
 };
 Blends blendAll(const std::vector<Image>& weights, std::span<const BaseOutputs* const> bases,
                 const EnsembleGuides& guides) {
-  return {blend(weights, outputsOf(bases, BufferPart::Full), guides.color),
-          blend(weights, outputsOf(bases, BufferPart::HalfA), guides.colorA),
-          blend(weights, outputsOf(bases, BufferPart::HalfB), guides.colorB)};
+  return {blend(weights, outputsOf(bases, &BaseOutputs::full), guides.color),
+          blend(weights, outputsOf(bases, &BaseOutputs::a), guides.colorA),
+          blend(weights, outputsOf(bases, &BaseOutputs::b), guides.colorB)};
 }
 
 // Weight filter step shared by the combiners: guided by the blend of `weights`.

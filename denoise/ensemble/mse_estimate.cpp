@@ -6,8 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "common/error.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
 
 namespace chorus {
 namespace {
@@ -219,9 +219,13 @@ BaseMask MseEstimator::validAt(size_t pixel) const {
   return mask;
 }
 
-BaseMask MseEstimator::solvableAt(size_t pixel) const { return masksAt(pixel).solvable; }
+BaseMask MseEstimator::solvableAt(size_t pixel) const {
+  return masksAt(pixel).solvable;
+}
 
-bool MseEstimator::noBasePlausible(size_t pixel) const { return masksAt(pixel).noisyFallback; }
+bool MseEstimator::noBasePlausible(size_t pixel) const {
+  return masksAt(pixel).noisyFallback;
+}
 
 MseEstimator::PixelMasks MseEstimator::masksAt(size_t pixel) const {
   const BaseMask valid = validAt(pixel);
@@ -237,9 +241,9 @@ MseEstimator::PixelMasks MseEstimator::masksAt(size_t pixel) const {
   const HalfTerms terms = halfTermsAt(pixel, valid);
   if (options_.plausibility > 0) masks.solvable = plausibleBases(kept, terms);
   const double k2 = options_.noisyFallback * options_.noisyFallback;
-  masks.noisyFallback = options_.noisyFallback > 0 &&
-                        terms.least(valid, baseCount_).mean >
-                            k2 * (terms.halvesApart + terms.floorMean);
+  masks.noisyFallback =
+      options_.noisyFallback > 0 &&
+      terms.least(valid, baseCount_).mean > k2 * (terms.halvesApart + terms.floorMean);
   return masks;
 }
 

@@ -1,8 +1,8 @@
 #include "denoise/ensemble/outputs_directory.h"
 
-#include "denoise/image/exr_io.h"
-#include "denoise/util/atomic_file.h"
-#include "denoise/util/error.h"
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "common/image/exr_io.h"
 
 namespace chorus {
 namespace fs = std::filesystem;

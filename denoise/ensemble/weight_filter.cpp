@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/error.h"
 #include "denoise/ensemble/planar_filter.h"
-#include "denoise/util/error.h"
 
 namespace chorus {
 namespace {

@@ -15,8 +15,8 @@
 #include <span>
 #include <vector>
 
+#include "common/image/image.h"
 #include "denoise/ensemble/ensemble_types.h"
-#include "denoise/image/image.h"
 
 namespace chorus {
 

@@ -5,7 +5,7 @@
 #include <limits>
 #include <vector>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 
 namespace chorus {
 

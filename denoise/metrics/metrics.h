@@ -17,7 +17,7 @@
 //   SMAPE   mean |x − r| / (|x| + |r| + ε), ε = 0.01 (Vogels et al. 2018), in [0, 1)
 #include <string>
 
-#include "denoise/image/image.h"
+#include "common/image/image.h"
 
 namespace chorus {
 

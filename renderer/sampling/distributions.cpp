@@ -5,7 +5,7 @@
 #include <cmath>
 #include <string>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 
 namespace chorus::render {
 

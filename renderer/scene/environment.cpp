@@ -7,8 +7,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "denoise/image/exr_io.h"
-#include "denoise/util/error.h"
+#include "common/error.h"
+#include "common/image/exr_io.h"
 
 namespace chorus::render {
 namespace {

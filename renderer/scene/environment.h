@@ -10,7 +10,7 @@
 #include <memory>
 #include <string>
 
-#include "denoise/image/image.h"
+#include "common/image/image.h"
 #include "renderer/math/vec.h"
 
 namespace chorus::render {

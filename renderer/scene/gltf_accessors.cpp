@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 
 namespace chorus::render::gltf {
 namespace {

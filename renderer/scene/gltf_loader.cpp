@@ -7,7 +7,7 @@
 #include <fstream>
 #include <set>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 #include "renderer/math/transform.h"
 #include "renderer/scene/gltf_accessors.h"
 #include "renderer/scene/gltf_materials.h"

@@ -5,7 +5,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 #include "renderer/scene/texture.h"
 
 namespace chorus::render::gltf {

@@ -6,7 +6,7 @@
 #include <cstring>
 #include <string>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 #include "renderer/integrator/ray_offset.h"
 #include "renderer/scene/material_eval.h"
 

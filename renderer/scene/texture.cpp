@@ -5,7 +5,7 @@
 #include <climits>
 #include <cmath>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 
 namespace chorus::render {
 namespace {

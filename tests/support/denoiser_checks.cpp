@@ -9,11 +9,11 @@
 #include <iostream>
 #include <vector>
 
+#include "common/error.h"
+#include "common/image/exr_io.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/tungsten_dir.h"
-#include "denoise/image/exr_io.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
 
 namespace chorus::test {
 

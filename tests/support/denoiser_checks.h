@@ -10,8 +10,8 @@
 #include <memory>
 #include <string>
 
+#include "common/image/image.h"
 #include "denoise/base/base_denoiser.h"
-#include "denoise/image/image.h"
 #include "tests/support/synthetic_scene.h"
 
 namespace chorus::test {

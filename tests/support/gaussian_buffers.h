@@ -4,8 +4,8 @@
 // another buffer (e.g. the synthetic scene's), identical in both halves.
 #include <cstdint>
 
+#include "common/image/image.h"
 #include "denoise/buffers/sample_buffers.h"
-#include "denoise/image/image.h"
 
 namespace chorus::test {
 

@@ -23,8 +23,8 @@
 #include <cstdint>
 #include <optional>
 
+#include "common/image/image.h"
 #include "denoise/buffers/sample_buffers.h"
-#include "denoise/image/image.h"
 
 namespace chorus::test {
 

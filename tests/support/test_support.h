@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "denoise/image/image.h"
+#include "common/image/image.h"
 
 namespace chorus::test {
 

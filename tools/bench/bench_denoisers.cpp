@@ -34,16 +34,16 @@
 #include <string>
 #include <vector>
 
+#include "common/error.h"
+#include "common/image/exr_io.h"
+#include "common/memory_reuse.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/tungsten_dir.h"
-#include "denoise/image/exr_io.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
 #include "renderer/render.h"
 #include "renderer/scene/gltf_loader.h"
 #include "tests/support/synthetic_scene.h"
 #include "tools/sweep/reference_render.h"
-#include "denoise/util/memory_reuse.h"
 
 namespace chorus::bench {
 namespace {
@@ -61,7 +61,7 @@ struct BenchOptions {
   int threads = 2;
   int repeat = 1;
   bool oracle = false;
-  std::string methods;  // comma-separated specs; empty = every registered denoiser
+  std::string methods;                 // comma-separated specs; empty = every registered denoiser
   std::string saveOutputs, compareTo;  // directories ("" = none)
 };
 

@@ -21,11 +21,11 @@
 #include <string>
 #include <vector>
 
+#include "common/memory_reuse.h"
+#include "common/stopwatch.h"
 #include "denoise/ensemble/combiners.h"
-#include "denoise/ensemble/synthetic_cases.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/stopwatch.h"
-#include "denoise/util/memory_reuse.h"
+#include "tests/support/synthetic_cases.h"
 
 namespace {
 using namespace chorus;

@@ -1,5 +1,5 @@
 // Chooses the ensemble's default options by measurement: for every documented synthetic case
-// (denoise/ensemble/synthetic_cases.h) runs each combiner and each MSE option variant and prints
+// (tests/support/synthetic_cases.h) runs each combiner and each MSE option variant and prints
 // relMSE tables — per variant, the geometric mean of relMSE over the cases and how often it
 // beats the best single base output — then the same for every combiner at the default options.
 // Never run by CTest.
@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "denoise/ensemble/combiners.h"
-#include "denoise/ensemble/synthetic_cases.h"
 #include "denoise/metrics/metrics.h"
+#include "tests/support/synthetic_cases.h"
 
 namespace {
 using namespace chorus;

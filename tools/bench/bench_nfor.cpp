@@ -18,13 +18,13 @@
 #include <filesystem>
 #include <string>
 
-#include "denoise/base/dual_buffer_nlm.h"
-#include "denoise/base/nfor.h"
+#include "common/error.h"
+#include "common/image/exr_io.h"
+#include "common/memory_reuse.h"
+#include "denoise/base/nfor/nfor.h"
+#include "denoise/base/nlm/dual_buffer_nlm.h"
 #include "denoise/buffers/tungsten_dir.h"
-#include "denoise/image/exr_io.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
-#include "denoise/util/memory_reuse.h"
 
 namespace chorus {
 namespace {

@@ -14,12 +14,12 @@
 #include <string>
 #include <vector>
 
+#include "common/image/png_io.h"
+#include "common/memory_reuse.h"
+#include "common/stopwatch.h"
 #include "denoise/base/registry.h"
-#include "denoise/ensemble/ensemble.h"
-#include "denoise/image/png_io.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/memory_reuse.h"
-#include "denoise/util/stopwatch.h"
+#include "denoise/pipeline/ensemble.h"
 #include "renderer/render.h"
 #include "renderer/scene/gltf_loader.h"
 #include "tools/chorus/render_denoise.h"

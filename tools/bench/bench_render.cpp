@@ -30,8 +30,8 @@
 #include <thread>
 #include <vector>
 
+#include "common/memory_reuse.h"
 #include "denoise/buffers/buffers_exr.h"
-#include "denoise/util/memory_reuse.h"
 #include "renderer/render.h"
 #include "renderer/sampling/warps.h"
 #include "renderer/scene/gltf_loader.h"

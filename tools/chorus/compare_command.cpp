@@ -5,9 +5,9 @@
 #include <cstdio>
 #include <iostream>
 
-#include "denoise/image/exr_io.h"
+#include "common/error.h"
+#include "common/image/exr_io.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
 #include "tools/chorus/command.h"
 
 namespace chorus::cli {

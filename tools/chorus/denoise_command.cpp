@@ -14,17 +14,17 @@
 #include <string>
 #include <vector>
 
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "common/image/exr_io.h"
+#include "common/image/png_io.h"
+#include "common/stopwatch.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/buffers_exr.h"
 #include "denoise/buffers/tungsten_dir.h"
-#include "denoise/ensemble/ensemble.h"
 #include "denoise/ensemble/outputs_directory.h"
-#include "denoise/image/exr_io.h"
-#include "denoise/image/png_io.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/atomic_file.h"
-#include "denoise/util/error.h"
-#include "denoise/util/stopwatch.h"
+#include "denoise/pipeline/ensemble.h"
 #include "tools/chorus/command.h"
 #include "tools/chorus/ensemble_flags.h"
 #include "tools/chorus/ensemble_outputs.h"

@@ -1,6 +1,6 @@
 #include "tools/chorus/ensemble_flags.h"
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 
 namespace chorus::cli {
 

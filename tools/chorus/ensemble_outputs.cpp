@@ -3,10 +3,10 @@
 #include <cctype>
 #include <cmath>
 
-#include "denoise/image/exr_io.h"
-#include "denoise/image/png_io.h"
+#include "common/error.h"
+#include "common/image/exr_io.h"
+#include "common/image/png_io.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/error.h"
 
 namespace chorus::cli {
 

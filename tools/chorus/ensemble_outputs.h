@@ -8,14 +8,14 @@
 #include <string>
 #include <vector>
 
-#include "denoise/ensemble/ensemble.h"
+#include "denoise/pipeline/ensemble.h"
 
 namespace chorus::cli {
 
 // A method spec as a file and layer name: "nlm:k=0.4" → "nlm_k=0.4".
 std::string labelOf(const std::string& spec);
 
-// membersFromSpecs (denoise/ensemble/ensemble.h) with labelOf labels, for file and layer names.
+// membersFromSpecs (denoise/pipeline/ensemble.h) with labelOf labels, for file and layer names.
 std::vector<EnsembleMember> fileSafeMembers(const std::vector<std::string>& specs);
 
 // Throws chorus::Error naming `file` unless the reference read from it is width × height.

@@ -4,9 +4,9 @@
 #include <iostream>
 #include <vector>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
+#include "common/memory_reuse.h"
 #include "tools/chorus/command.h"
-#include "denoise/util/memory_reuse.h"
 
 namespace chorus::cli {
 

@@ -8,12 +8,12 @@
 #include <optional>
 #include <string>
 
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "common/image/exr_io.h"
+#include "common/image/png_io.h"
+#include "common/stopwatch.h"
 #include "denoise/buffers/buffers_exr.h"
-#include "denoise/image/exr_io.h"
-#include "denoise/image/png_io.h"
-#include "denoise/util/atomic_file.h"
-#include "denoise/util/error.h"
-#include "denoise/util/stopwatch.h"
 #include "renderer/render.h"
 #include "tools/chorus/command.h"
 #include "tools/chorus/ensemble_flags.h"

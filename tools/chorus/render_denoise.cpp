@@ -1,9 +1,9 @@
 #include "tools/chorus/render_denoise.h"
 
+#include "common/error.h"
+#include "common/image/png_io.h"
+#include "common/stopwatch.h"
 #include "denoise/base/registry.h"
-#include "denoise/image/png_io.h"
-#include "denoise/util/error.h"
-#include "denoise/util/stopwatch.h"
 #include "tools/chorus/ensemble_outputs.h"
 
 namespace chorus::cli {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "denoise/ensemble/combiners.h"
-#include "denoise/ensemble/ensemble.h"
+#include "denoise/pipeline/ensemble.h"
 
 namespace chorus::cli {
 

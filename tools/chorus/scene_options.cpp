@@ -2,7 +2,7 @@
 
 #include <iostream>
 
-#include "denoise/util/stopwatch.h"
+#include "common/stopwatch.h"
 #include "renderer/scene/environment.h"
 #include "renderer/scene/gltf_loader.h"
 

@@ -1,7 +1,6 @@
 // chorus sweep SCENE... --out DIR: sample-count sweeps of every base denoiser and every
 // combination × combiner against a reference, with results.csv and a self-contained
 // report.html (tools/sweep/). `--merge DIR...` combines the directories of sharded runs.
-#include <tbb/global_control.h>
 
 #include <iostream>
 #include <memory>
@@ -10,8 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "common/error.h"
+#include "common/thread_limit.h"
 #include "denoise/base/registry.h"
-#include "denoise/util/error.h"
 #include "tools/chorus/command.h"
 #include "tools/chorus/ensemble_flags.h"
 #include "tools/chorus/scene_options.h"
@@ -109,9 +109,7 @@ void runSweepCommand(const SweepArgs& args) {
   config.progress = args.quiet ? nullptr : &std::cerr;
   config.report.details = describe(config, args);
   // Denoisers run on TBB: --threads limits them as it limits the renderer.
-  std::optional<tbb::global_control> threads;
-  if (config.render.threads > 0)
-    threads.emplace(tbb::global_control::max_allowed_parallelism, size_t(config.render.threads));
+  const ThreadLimit threads(config.render.threads);
 
   const sweep::SweepRunStats stats = sweep::runSweep(config);
   if (!args.quiet)

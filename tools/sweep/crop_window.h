@@ -1,7 +1,7 @@
 #pragma once
 // The crop the sweep report shows per case: the square window where the noisy input's relMSE
 // is largest, i.e. where the denoisers have the most to do and differ the most.
-#include "denoise/image/image.h"
+#include "common/image/image.h"
 
 namespace chorus::sweep {
 

@@ -2,9 +2,9 @@
 
 #include <cstdio>
 
-#include "denoise/image/exr_io.h"
-#include "denoise/util/atomic_file.h"
-#include "denoise/util/stopwatch.h"
+#include "common/atomic_file.h"
+#include "common/image/exr_io.h"
+#include "common/stopwatch.h"
 
 namespace chorus::sweep {
 

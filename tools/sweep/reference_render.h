@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <string>
 
-#include "denoise/image/image.h"
+#include "common/image/image.h"
 #include "renderer/render.h"
 
 namespace chorus::sweep {

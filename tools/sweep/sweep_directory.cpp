@@ -5,8 +5,8 @@
 #include <sstream>
 #include <tuple>
 
-#include "denoise/util/atomic_file.h"
-#include "denoise/util/error.h"
+#include "common/atomic_file.h"
+#include "common/error.h"
 
 namespace chorus::sweep {
 

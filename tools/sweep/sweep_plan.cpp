@@ -6,7 +6,7 @@
 #include <map>
 #include <sstream>
 
-#include "denoise/util/error.h"
+#include "common/error.h"
 #include "tools/sweep/sweep_results.h"
 
 namespace chorus::sweep {

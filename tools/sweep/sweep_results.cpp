@@ -4,8 +4,8 @@
 #include <limits>
 #include <sstream>
 
-#include "denoise/util/atomic_file.h"
-#include "denoise/util/error.h"
+#include "common/atomic_file.h"
+#include "common/error.h"
 
 namespace chorus::sweep {
 

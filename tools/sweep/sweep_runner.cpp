@@ -8,14 +8,14 @@
 #include <set>
 #include <sstream>
 
-#include "denoise/ensemble/ensemble.h"
-#include "denoise/image/exr_io.h"
-#include "denoise/image/false_color.h"
-#include "denoise/image/png_io.h"
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "common/image/exr_io.h"
+#include "common/image/false_color.h"
+#include "common/image/png_io.h"
+#include "common/stopwatch.h"
 #include "denoise/metrics/metrics.h"
-#include "denoise/util/atomic_file.h"
-#include "denoise/util/error.h"
-#include "denoise/util/stopwatch.h"
+#include "denoise/pipeline/ensemble.h"
 #include "renderer/scene/gltf_loader.h"
 #include "tools/sweep/crop_window.h"
 #include "tools/sweep/reference_render.h"
@@ -93,9 +93,8 @@ std::string sweepSettings(const SweepConfig& config) {
        << c.mse.windowRadius << (c.mse.relative ? " relative" : " absolute") << " outlier-cap "
        << c.mse.outlierCap << " consistency " << c.mse.consistency << " plausibility "
        << c.mse.plausibility << " image-prior " << c.mse.imagePrior << " noisy-fallback "
-       << c.mse.noisyFallback << " filter "
-       << (c.filter.enabled ? "bilateral" : "none") << " seed " << c.seed << "\ncrop "
-       << config.cropSize << "\n";
+       << c.mse.noisyFallback << " filter " << (c.filter.enabled ? "bilateral" : "none") << " seed "
+       << c.seed << "\ncrop " << config.cropSize << "\n";
   return text.str();
 }
 

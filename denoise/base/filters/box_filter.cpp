@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "denoise/image/planar_image.h"
+#include "denoise/planes/planar_image.h"
 #include "denoise/util/parallel_rows.h"
 #include "denoise/util/simd_clones.h"
 

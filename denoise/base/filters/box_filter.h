@@ -6,8 +6,8 @@
 // sums.
 #include <vector>
 
+#include "common/image/image.h"
 #include "denoise/base/filters/pixel_rect.h"
-#include "denoise/image/image.h"
 
 namespace chorus {
 

@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "denoise/base/bordered_planes.h"
+#include "denoise/base/filters/bordered_planes.h"
 #include "denoise/util/simd_clones.h"
 
 // The kernels below are built for AVX-512F, AVX2 and the baseline (simd_clones.h). Contraction
@@ -179,10 +179,9 @@ CHORUS_SIMD_CLONES void accumulateSums(const Group& g, Lanes* sums, float* group
 template <int kD, int kC>
 [[gnu::always_inline]] inline void accumulatePredictionsOf(const Group& g,
                                                            const float* groupWeights,
-                                                           const uint8_t* skip,
-                                                           const Lanes* beta, float* acc,
-                                                           size_t accWidth, size_t accPlane,
-                                                           size_t accAt) {
+                                                           const uint8_t* skip, const Lanes* beta,
+                                                           float* acc, size_t accWidth,
+                                                           size_t accPlane, size_t accAt) {
   const int d = kD ? kD : g.d, C = kD ? kC : g.channels;
   Lanes fp[kMaxGramSize], x[kMaxColumns];
   centreFeatures(g, d, fp);
@@ -208,8 +207,8 @@ CHORUS_SIMD_CLONES void accumulatePredictions(const Group& g, const float* group
                                               const uint8_t* skip, const Lanes* beta, float* acc,
                                               size_t accWidth, size_t accPlane, size_t accAt) {
   if (g.d == kNforColumns && g.channels == kNforChannels)
-    accumulatePredictionsOf<kNforColumns, kNforChannels>(g, groupWeights, skip, beta, acc,
-                                                         accWidth, accPlane, accAt);
+    accumulatePredictionsOf<kNforColumns, kNforChannels>(g, groupWeights, skip, beta, acc, accWidth,
+                                                         accPlane, accAt);
   else
     accumulatePredictionsOf<0, 0>(g, groupWeights, skip, beta, acc, accWidth, accPlane, accAt);
 }
@@ -298,15 +297,15 @@ class Regression {
     st.skip.resize(size_t(side_ * side_));
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x0 = tile.x0; x0 < std::min(tile.x1, width_); x0 += kLanes) {
-        const Group g{.x0 = x0,
-                      .y = y,
-                      .r = r_,
-                      .d = d_,
-                      .channels = channels_,
-                      .weights = st.table.data() + size_t(y - tile.y0) * kTileSize +
-                                 size_t(x0 - tile.x0),
-                      .weightStride = planeStride(),
-                      .fu = &fu_};
+        const Group g{
+            .x0 = x0,
+            .y = y,
+            .r = r_,
+            .d = d_,
+            .channels = channels_,
+            .weights = st.table.data() + size_t(y - tile.y0) * kTileSize + size_t(x0 - tile.x0),
+            .weightStride = planeStride(),
+            .fu = &fu_};
         accumulateSums(g, st.sums, st.groupWeights.data(), st.skip.data());
         Lanes beta[kMaxGramSize * kMaxGramRhs];
         solveLanes(st.sums, std::min(kLanes, width_ - x0), beta);
@@ -359,8 +358,8 @@ class Regression {
         for (int x = 0; x < width_; ++x) {
           const size_t i = size_t(y - rows.y0) * size_t(width_) + size_t(x);
           for (int c = 0; c < channels_; ++c)
-            result(x, y, c) = wsum[i] > 0.0f ? acc[size_t(c) * area + i] / wsum[i]
-                                             : fu_.row(m_ + c, y)[x];
+            result(x, y, c) =
+                wsum[i] > 0.0f ? acc[size_t(c) * area + i] / wsum[i] : fu_.row(m_ + c, y)[x];
         }
     });
     return result;

@@ -10,9 +10,9 @@
 // order, so the result does not depend on the thread count. Within a tile, sixteen consecutive
 // centres of a row are regressed together, one per vector lane (AVX-512, AVX2 and baseline
 // builds give the same bits).
+#include "common/image/image.h"
 #include "denoise/base/filters/gram_solver.h"
 #include "denoise/base/filters/nlmeans_weights.h"
-#include "denoise/image/image.h"
 
 namespace chorus {
 

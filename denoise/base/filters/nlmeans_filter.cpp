@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "denoise/image/planar_image.h"
+#include "denoise/planes/planar_image.h"
 #include "denoise/util/simd_clones.h"
 
 // The accumulation kernel is built for AVX-512F, AVX2 and the baseline (simd_clones.h), without

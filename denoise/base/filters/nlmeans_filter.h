@@ -8,8 +8,8 @@
 #include <span>
 #include <vector>
 
+#include "common/image/image.h"
 #include "denoise/base/filters/nlmeans_weights.h"
-#include "denoise/image/image.h"
 
 namespace chorus {
 

@@ -26,9 +26,9 @@
 #include <span>
 #include <vector>
 
+#include "common/image/image.h"
 #include "denoise/base/filters/pixel_rect.h"
-#include "denoise/image/image.h"
-#include "denoise/image/padded_planes.h"
+#include "denoise/planes/padded_planes.h"
 
 namespace chorus {
 

@@ -1,0 +1,245 @@
+#include "denoise/base/nfor/nfor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "common/error.h"
+#include "denoise/base/filters/collaborative_regression.h"
+#include "denoise/base/filters/nlmeans_filter.h"
+#include "denoise/base/variance_estimates.h"
+
+namespace chorus {
+
+NforParams NforParams::fromParams(ParamMap& map) {
+  NforParams p;
+  p.prefilterF = map.getInt("prefilterF", p.prefilterF);
+  p.prefilterR = map.getInt("prefilterR", p.prefilterR);
+  p.prefilterK = map.getFloat("prefilterK", p.prefilterK);
+  p.regressionF = map.getInt("regressionF", p.regressionF);
+  p.regressionR = map.getInt("regressionR", p.regressionR);
+  p.k1 = map.getFloat("k1", p.k1);
+  p.k2 = map.getFloat("k2", p.k2);
+  p.mseF = map.getInt("mseF", p.mseF);
+  p.mseR = map.getInt("mseR", p.mseR);
+  p.mseK = map.getFloat("mseK", p.mseK);
+  p.finalFeatureF = map.getInt("finalFeatureF", p.finalFeatureF);
+  p.finalFeatureR = map.getInt("finalFeatureR", p.finalFeatureR);
+  p.finalFeatureK = map.getFloat("finalFeatureK", p.finalFeatureK);
+  p.finalF = map.getInt("finalF", p.finalF);
+  p.finalR = map.getInt("finalR", p.finalR);
+  p.finalK = map.getFloat("finalK", p.finalK);
+  p.epsilon = map.getFloat("epsilon", p.epsilon);
+  p.distanceClamp = map.getFloat("distanceClamp", p.distanceClamp);
+  p.minCenterWeight = map.getFloat("minCenterWeight", p.minCenterWeight);
+  for (int v : {p.prefilterF, p.prefilterR, p.regressionF, p.regressionR, p.mseF, p.mseR,
+                p.finalFeatureF, p.finalFeatureR, p.finalF, p.finalR})
+    if (v < 0 || v > 32) throw Error("nfor: patch and window radii must be in [0, 32]");
+  for (float k : {p.prefilterK, p.k1, p.k2, p.mseK, p.finalFeatureK, p.finalK})
+    if (!(k > 0)) throw Error("nfor: bandwidths k must be positive");
+  return p;
+}
+
+namespace {
+
+// Radiance beyond this is treated as this, so that squared errors stay finite in float.
+constexpr float kMaxMagnitude = 1e12f;
+
+float sanitizeValue(float v) {
+  return std::isfinite(v) ? std::clamp(v, -kMaxMagnitude, kMaxMagnitude) : 0.0f;
+}
+
+Image sanitized(const Image& image) {
+  Image out = image;
+  for (float& v : out.values()) v = sanitizeValue(v);
+  return out;
+}
+
+// Tungsten's feature order: depth, albedo R G B, normal x y z, visibility.
+constexpr Quantity kFeatureOrder[] = {Quantity::Depth, Quantity::Albedo, Quantity::Normal,
+                                      Quantity::Visibility};
+
+int featureChannelCount() {
+  int m = 0;
+  for (Quantity q : kFeatureOrder) m += channelCount(q);
+  return m;
+}
+
+// The features of a buffer as one image with a channel per scalar feature. Where a feature
+// mean is not finite its variance becomes NaN ("no sample": matches nothing) and the mean 0.
+Image featureMeans(const SubBuffer& buffer) {
+  Image out(buffer.width(), buffer.height(), featureChannelCount());
+  int channel = 0;
+  for (Quantity q : kFeatureOrder) {
+    const Image& mean = buffer.get(q).mean;
+    for (int c = 0; c < mean.channels(); ++c, ++channel)
+      for (int y = 0; y < out.height(); ++y)
+        for (int x = 0; x < out.width(); ++x) out(x, y, channel) = sanitizeValue(mean(x, y, c));
+  }
+  return out;
+}
+
+Image featureVariances(const DenoiseInput& input) {
+  const auto& halves = *input.halves;
+  Image out(input.width(), input.height(), featureChannelCount());
+  int channel = 0;
+  for (Quantity q : kFeatureOrder) {
+    const Image variance = wholeVarianceOfMean(input, q);
+    const Image& m1 = halves[0].get(q).mean;
+    const Image& m2 = halves[1].get(q).mean;
+    for (int c = 0; c < variance.channels(); ++c, ++channel)
+      for (int y = 0; y < out.height(); ++y)
+        for (int x = 0; x < out.width(); ++x) {
+          const bool known = std::isfinite(m1(x, y, c)) && std::isfinite(m2(x, y, c));
+          out(x, y, channel) = known ? variance(x, y, c) : std::numeric_limits<float>::quiet_NaN();
+        }
+  }
+  return out;
+}
+
+Image colorVariance(const DenoiseInput& input) {
+  Image variance = wholeVarianceOfMean(input, Quantity::Color);
+  const auto& halves = *input.halves;
+  for (size_t i = 0; i < variance.size(); ++i)
+    if (!std::isfinite(halves[0].color.mean.data()[i]) ||
+        !std::isfinite(halves[1].color.mean.data()[i]))
+      variance.data()[i] = std::numeric_limits<float>::quiet_NaN();
+  return variance;
+}
+
+// Per-pixel arithmetic on images of the same shape.
+template <typename Fn>
+Image combine(const Image& a, const Image& b, Fn&& fn) {
+  Image out(a.width(), a.height(), a.channels());
+  for (size_t i = 0; i < out.size(); ++i) out.data()[i] = fn(a.data()[i], b.data()[i]);
+  return out;
+}
+
+class NforRun {
+ public:
+  NforRun(const NforParams& p, const DenoiseInput& input) : p_(p), input_(input) {}
+
+  Image run() {
+    const auto& halves = *input_.halves;
+    const Image c1 = sanitized(halves[0].color.mean), c2 = sanitized(halves[1].color.mean);
+    const Image c = sanitized(input_.whole.color.mean);
+    const Image sigma2 = colorVariance(input_);
+
+    // Feature cross-prefiltering (§5.1): A's features with weights from B's, and vice versa.
+    const Image f1 = featureMeans(halves[0]), f2 = featureMeans(halves[1]);
+    const Image fVar = featureVariances(input_);
+    const NlMeansParams prefilterWindow = window(p_.prefilterR);
+    const Image f1Filtered =
+        nlMeans(f1, perChannelTerm(f2, fVar, p_.prefilterF, p_.prefilterK, 2.0f), prefilterWindow);
+    const Image f2Filtered =
+        nlMeans(f2, perChannelTerm(f1, fVar, p_.prefilterF, p_.prefilterK, 2.0f), prefilterWindow);
+
+    // Regression passes (§5.2): colour of one half, weights from the other half's colour,
+    // regressed on the other half's filtered features.
+    Image y1[2], y2[2], mse[2];
+    const float ks[2] = {p_.k1, p_.k2};
+    for (int i = 0; i < 2; ++i) {
+      y1[i] = regress(c1, f2Filtered, c2, sigma2, p_.regressionF, ks[i], p_.regressionR);
+      y2[i] = regress(c2, f1Filtered, c1, sigma2, p_.regressionF, ks[i], p_.regressionR);
+      mse[i] = mseEstimate(c1, c2, y1[i], y2[i], sigma2);
+    }
+
+    // Bandwidth selection (§5.3): smoothed MSE, per-channel binary map, smoothed map.
+    const NlMeansWeights smoothing(perChannelTerm(c, sigma2, p_.mseF, p_.mseK, 1.0f),
+                                   window(p_.mseR));
+    const Image* mses[] = {&mse[0], &mse[1]};
+    const NlMeansFilterResult smoothed = nlMeansFilterAll(mses, smoothing);
+    const Image noisySelection = combine(smoothed.filtered[0], smoothed.filtered[1],
+                                         [](float e1, float e2) { return e1 < e2 ? 0.0f : 1.0f; });
+    const Image selection = nlMeansFilter(noisySelection, smoothing);
+    const Image r1 = blend(y1[0], y1[1], selection), r2 = blend(y2[0], y2[1], selection);
+
+    // Second filter pass (§5.4) on the means of the halves, with their dual-buffer variances.
+    const Image fMean =
+        combine(f1Filtered, f2Filtered, [](float a, float b) { return (a + b) * 0.5f; });
+    const Image fMeanVar =
+        combine(f1Filtered, f2Filtered, [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
+    const Image fFinal =
+        nlMeans(fMean, perChannelTerm(fMean, fMeanVar, p_.finalFeatureF, p_.finalFeatureK, 1.0f),
+                window(p_.finalFeatureR));
+    const Image rMean = combine(r1, r2, [](float a, float b) { return (a + b) * 0.5f; });
+    const Image rMeanVar =
+        combine(r1, r2, [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
+    Image out = regress(rMean, fFinal, rMean, rMeanVar, p_.finalF, p_.finalK, p_.finalR);
+
+    for (size_t i = 0; i < out.size(); ++i)
+      if (!std::isfinite(out.data()[i])) out.data()[i] = c.data()[i];
+    return out;
+  }
+
+ private:
+  NlMeansParams window(int r) const {
+    return {.r = r, .center = CenterWeight::Computed, .minCenterWeight = p_.minCenterWeight};
+  }
+
+  NlMeansTerm perChannelTerm(const Image& guide, const Image& variance, int f, float k,
+                             float s) const {
+    return {.guide = &guide,
+            .variance = &variance,
+            .f = f,
+            .k = k,
+            .alpha = 1.0f,
+            .s = s,
+            .epsilon = p_.epsilon,
+            .distanceClamp = p_.distanceClamp,
+            .channels = ChannelWeights::PerChannel};
+  }
+
+  // Tungsten's regression weights: one weight per pixel (min over the colour channels), the
+  // variance scale always 2 (a half's variance is twice the whole's) — also in the final pass,
+  // where it is kept for fidelity.
+  Image regress(const Image& image, const Image& features, const Image& guide,
+                const Image& variance, int f, float k, int r) const {
+    const NlMeansTerm term{.guide = &guide,
+                           .variance = &variance,
+                           .f = f,
+                           .k = k,
+                           .alpha = 1.0f,
+                           .s = 2.0f,
+                           .epsilon = p_.epsilon,
+                           .distanceClamp = p_.distanceClamp,
+                           .channels = ChannelWeights::MinOverChannels};
+    return collaborativeRegression(image, features, NlMeansWeights(term, window(r)));
+  }
+
+  // e = ½[(c2 − y1)² − 2σ² + (c1 − y2)² − 2σ²] − ¼(y2 − y1)²: the error of the average of the
+  // two outputs (2σ² is a half's variance; the last term removes their residual variance).
+  static Image mseEstimate(const Image& c1, const Image& c2, const Image& y1, const Image& y2,
+                           const Image& sigma2) {
+    Image out(c1.width(), c1.height(), c1.channels());
+    for (size_t i = 0; i < out.size(); ++i) {
+      const float v = sigma2.data()[i], a = c2.data()[i] - y1.data()[i];
+      const float b = c1.data()[i] - y2.data()[i], r = y2.data()[i] - y1.data()[i];
+      float e = 0.5f * ((a * a - 2.0f * v) + (b * b - 2.0f * v)) - 0.25f * r * r;
+      out.data()[i] = std::isfinite(e) ? e : 0.0f;
+    }
+    return out;
+  }
+
+  static Image blend(const Image& a, const Image& b, const Image& t) {
+    Image out(a.width(), a.height(), a.channels());
+    for (size_t i = 0; i < out.size(); ++i) {
+      const float s = t.data()[i];
+      out.data()[i] = a.data()[i] * (1.0f - s) + b.data()[i] * s;
+    }
+    return out;
+  }
+
+  const NforParams& p_;
+  const DenoiseInput& input_;
+};
+
+}  // namespace
+
+Image NforDenoiser::run(const DenoiseInput& input) const {
+  if (!input.halves)
+    throw Error("nfor: needs two independent halves of its input (render with 2 or 4 sub-buffers)");
+  return NforRun(params_, input).run();
+}
+
+}  // namespace chorus

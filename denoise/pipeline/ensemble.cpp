@@ -1,0 +1,110 @@
+#include "denoise/pipeline/ensemble.h"
+
+#include <tbb/task_group.h>
+
+#include <set>
+
+#include "common/error.h"
+#include "common/stopwatch.h"
+#include "denoise/base/registry.h"
+#include "denoise/ensemble/ensemble_types.h"
+
+namespace chorus {
+
+std::vector<EnsembleMember> membersFromSpecs(std::span<const std::string> specs) {
+  std::vector<EnsembleMember> members;
+  for (const std::string& spec : specs)
+    members.push_back({spec, std::shared_ptr<const BaseDenoiser>(createDenoiser(spec))});
+  return members;
+}
+
+void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members) {
+  if (members.empty()) throw Error("no base denoisers given");
+  if (members.size() > size_t(kMaxDenoisers))
+    throw Error("at most " + std::to_string(kMaxDenoisers) + " base denoisers, got " +
+                std::to_string(members.size()));
+  std::set<std::string> labels;
+  for (const EnsembleMember& member : members) {
+    if (!labels.insert(member.label).second)
+      throw Error("base denoiser '" + member.label + "' is listed twice");
+    if (!member.denoiser->requirements().halves) continue;
+    const char* missing = !sources.a.halves      ? "half A"
+                          : !sources.b.halves    ? "half B"
+                          : !sources.full.halves ? "the full buffer"
+                                                 : nullptr;
+    if (missing)
+      throw Error("base denoiser '" + member.label +
+                  "' needs two independent halves of its own input, but " + missing +
+                  " has none (the ensemble runs it on half A and half B, which needs 4 "
+                  "independent sub-buffers; this input has only 2)");
+  }
+}
+
+int splitsNeeded(std::span<const EnsembleMember> members) {
+  for (const EnsembleMember& member : members)
+    if (member.denoiser->requirements().halves) return 4;
+  return 2;
+}
+
+bool readsHalves(std::span<const EnsembleMember> members) {
+  for (const EnsembleMember& member : members) {
+    const DenoiserRequirements r = member.denoiser->requirements();
+    if (r.halves || r.readsHalves) return true;
+  }
+  return false;
+}
+
+std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
+                                          std::span<const EnsembleMember> members,
+                                          std::vector<StageTime>* times) {
+  checkMembersCanRun(sources, members);
+  const Stopwatch all;
+  std::vector<BaseOutputs> outputs(members.size());
+  std::vector<double> seconds(members.size() * 3);
+  const DenoiseInput* inputs[3] = {&sources.a, &sources.b, &sources.full};
+  tbb::task_group group;
+  for (size_t m = 0; m < members.size(); ++m) {
+    outputs[m].name = members[m].label;
+    Image* targets[3] = {&outputs[m].a, &outputs[m].b, &outputs[m].full};
+    for (int part = 0; part < 3; ++part) {
+      group.run([&, m, part, target = targets[part]] {
+        const Stopwatch run;
+        *target = members[m].denoiser->run(*inputs[part]);
+        seconds[m * 3 + size_t(part)] = run.seconds();
+      });
+    }
+  }
+  group.wait();
+  if (times) {
+    const char* partNames[3] = {"A", "B", "full"};
+    for (size_t m = 0; m < members.size(); ++m)
+      for (int part = 0; part < 3; ++part)
+        times->push_back({members[m].label + "/" + partNames[part], seconds[m * 3 + size_t(part)]});
+    times->push_back({"bases", all.seconds()});
+  }
+  return outputs;
+}
+
+Ensemble::Ensemble(std::vector<EnsembleMember> members, CombineOptions options)
+    : members_(std::move(members)), options_(std::move(options)) {
+  for (EnsembleMember& member : members_) {
+    if (!member.denoiser) throw Error("Ensemble: a member has no denoiser");
+    if (member.label.empty()) member.label = member.denoiser->name();
+  }
+}
+
+EnsembleResult Ensemble::run(const SampleBuffers& buffers, const Image* reference) const {
+  return run(sourcesFromBuffers(buffers), reference);
+}
+
+EnsembleResult Ensemble::run(const EnsembleSources& sources, const Image* reference) const {
+  EnsembleResult result;
+  result.bases = runBaseDenoisers(sources, members_, &result.times);
+  result.guides = guidesFromSources(sources);
+  result.combined = combine(result.guides, pointersTo(result.bases), options_, reference);
+  result.times.insert(result.times.end(), result.combined.times.begin(),
+                      result.combined.times.end());
+  return result;
+}
+
+}  // namespace chorus

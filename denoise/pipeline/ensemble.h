@@ -1,0 +1,71 @@
+#pragma once
+// The ensemble runner: runs the chosen base denoisers on half A, half B and the full buffer (all
+// 3N runs in parallel as TBB tasks), then combines their outputs (combiners.h) and reports the
+// time of every stage. For sweeps that reuse base outputs across combinations, call
+// runBaseDenoisers() once and combine() per combination instead.
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "denoise/base/base_denoiser.h"
+#include "denoise/buffers/sample_buffers.h"
+#include "denoise/ensemble/combiners.h"
+#include "denoise/pipeline/ensemble_sources.h"
+
+namespace chorus {
+
+// A base denoiser and the label its outputs carry (layer and file names; must be unique).
+struct EnsembleMember {
+  std::string label;
+  std::shared_ptr<const BaseDenoiser> denoiser;
+};
+
+// One member per registry spec ("nfor", "jnlm:k=0.4"), labelled with the spec. Throws
+// chorus::Error for an unknown name or parameter (denoise/base/registry.h).
+std::vector<EnsembleMember> membersFromSpecs(std::span<const std::string> specs);
+
+// Throws chorus::Error (one line) when a member cannot run on these sources, e.g. a denoiser
+// that needs two halves of its own input while the half buffers have none (K = 2 renders and
+// Tungsten directories: only the full buffer has halves).
+void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members);
+
+// Sub-buffers a render needs for these members: 4 when one needs two halves of its own input (it
+// then runs on quarters inside each half: NFOR, RDFC, dual-buffer NL-means), else 2 (the
+// ensemble's halves A and B). Fewer sub-buffers mean less film to fill and merge.
+int splitsNeeded(std::span<const EnsembleMember> members);
+
+// Whether some member needs or reads the halves of its input (else sourcesFromBuffers can leave
+// the full input's halves out: two copies of the render less).
+bool readsHalves(std::span<const EnsembleMember> members);
+
+// Every member on sources.a, .b and .full, in parallel. Appends "<label>/A", "<label>/B",
+// "<label>/full" (the time of each run) and "bases" (wall time of all of them) to `times`.
+std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
+                                          std::span<const EnsembleMember> members,
+                                          std::vector<StageTime>* times = nullptr);
+
+struct EnsembleResult {
+  CombineResult combined;          // image, weights, A/B blends, estimated MSE
+  std::vector<BaseOutputs> bases;  // every base output (A, B, full), in member order
+  EnsembleGuides guides;           // the noisy inputs the weights were estimated from
+  std::vector<StageTime> times;    // every stage: base runs, "bases", "solve", "filter", "blend"
+};
+
+class Ensemble {
+ public:
+  Ensemble(std::vector<EnsembleMember> members, CombineOptions options);
+
+  const std::vector<EnsembleMember>& members() const { return members_; }
+  const CombineOptions& options() const { return options_; }
+
+  // From K = 2 or 4 sub-buffers (input(HalfA), input(HalfB), input(Full)).
+  EnsembleResult run(const SampleBuffers& buffers, const Image* reference = nullptr) const;
+  EnsembleResult run(const EnsembleSources& sources, const Image* reference = nullptr) const;
+
+ private:
+  std::vector<EnsembleMember> members_;
+  CombineOptions options_;
+};
+
+}  // namespace chorus

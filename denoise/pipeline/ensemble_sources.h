@@ -1,0 +1,35 @@
+#pragma once
+// The three inputs every base denoiser of an ensemble runs on (half A, half B, the full buffer),
+// made from a render's sub-buffers or from an input that already has two halves, and the noisy
+// guides the combination step reads from them.
+#include "denoise/buffers/sample_buffers.h"
+#include "denoise/ensemble/ensemble_inputs.h"
+
+namespace chorus {
+
+// The three inputs every base denoiser runs on. Each input sees only its own samples (the run
+// on A must not see B: the MSE estimate relies on y^A being independent of x^B).
+struct EnsembleSources {
+  DenoiseInput a, b, full;
+  int width() const { return full.width(); }
+  int height() const { return full.height(); }
+};
+
+// From K independent sub-buffers (K even): a = input(HalfA), b = input(HalfB), full =
+// input(Full). With K = 4 the half runs get quarters as their own halves; with K = 2 they get
+// none. Throws chorus::Error for an odd K.
+EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers);
+
+// The same, taking the sub-buffers over (K = 2: they become a and b instead of being copied;
+// `buffers` is left empty). Without `halvesOfFull`, full.halves stays empty (for members that
+// never read it: see readsHalves in ensemble.h).
+EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull);
+
+// From an input with two halves (e.g. a Tungsten directory): a = halves[0], b = halves[1]
+// (without halves of their own), full = the input. Throws chorus::Error without halves.
+EnsembleSources sourcesFromHalves(const DenoiseInput& input);
+
+// The noisy colour of the full buffer and both halves, and the full buffer's albedo and normal.
+EnsembleGuides guidesFromSources(const EnsembleSources& sources);
+
+}  // namespace chorus

@@ -171,12 +171,14 @@ const RegisterCommand registration(30, [](CLI::App& app) {
       ->check(CLI::PositiveNumber)
       ->each([args](const std::string&) { args->sppGiven = true; });
   cmd->add_option("--splits", args->splits,
-                  "Independent sub-buffers K: 1, 2 or 4 (default: what --denoise needs)")
+                  "Independent sub-buffers K: 1, 2 or 4 (default: what --denoise needs; with "
+                  "--denoise none, what the default members need, for a later `chorus denoise`)")
       ->check(CLI::IsMember({1, 2, 4}));
   args->sceneOptions.addFlags(*cmd);
   cmd->add_option("--denoise", args->denoise,
-                  std::string("Denoising after the render: none, default (") + kDefaultDenoise +
-                      "), preview (" + kPreviewDenoise +
+                  std::string("Denoising after the render: none (render.exr keeps the "
+                              "sub-buffers the default members need), default (") +
+                      kDefaultDenoise + "), preview (" + kPreviewDenoise +
                       ") or a comma-separated list of base denoisers (name or name:key=value; "
                       "`chorus denoise --help` lists them)")
       ->capture_default_str()

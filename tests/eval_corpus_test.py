@@ -86,6 +86,15 @@ class SplitFile(unittest.TestCase):
                     self.assertTrue(os.path.isfile(os.path.join(shared, "scenes", e[key][7:])),
                                     e[key])
 
+    def test_docs_table_lists_the_same_split(self):
+        with open(os.path.join(REPOSITORY, "docs", "evaluation.md"), encoding="utf-8") as f:
+            text = f.read()
+        # The first table after the heading: one row per entry, its name and half first.
+        section = text[text.index("## The corpus and its split"):]
+        rows = section[section.index("\n|") + 1:].split("\n\n")[0].splitlines()[2:]
+        halves = {r.split("|")[1].strip(): r.split("|")[2].strip() for r in rows}
+        self.assertEqual(halves, corpus_file.half_of(self.corpus))
+
     def write_corpus(self, directory, entries):
         path = os.path.join(directory, "corpus.json")
         with open(path, "w") as f:

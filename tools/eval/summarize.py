@@ -216,7 +216,13 @@ def print_member_check(table, out):
         return
     out.write("\nIssue 26: member relMSE / noisy relMSE (target ≤ 1 everywhere): %d of %d "
               "(scene, spp, member) worse than the noisy input\n\n" % (len(worse), total))
-    out.write("| scene | spp | noisy relMSE | " + " | ".join(methods) + " |\n")
+    out.write("| member | (scene, spp) worse than noisy | worst member / noisy |\n|---|---|---|\n")
+    for m in methods:
+        mine = [(row["ratios"][m], row["scene"], row["spp"]) for row in table if m in row["ratios"]]
+        bad = sum(1 for r, _, _ in mine if not r <= 1.0)
+        worst = max(mine, key=lambda t: (not t[0] <= math.inf, t[0]))
+        out.write("| %s | %d of %d | %.3g (%s %d spp) |\n" % (m, bad, len(mine), *worst))
+    out.write("\n| scene | spp | noisy relMSE | " + " | ".join(methods) + " |\n")
     out.write("|---|---|---|" + "---|" * len(methods) + "\n")
     for row in table:
         cells = []

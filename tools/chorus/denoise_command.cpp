@@ -17,7 +17,9 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/image/exr_io.h"
+#include "common/image/finite_pixels.h"
 #include "common/image/png_io.h"
+#include "common/owned_directory.h"
 #include "common/stopwatch.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/buffers_exr.h"
@@ -28,6 +30,7 @@
 #include "tools/chorus/command.h"
 #include "tools/chorus/ensemble_flags.h"
 #include "tools/chorus/ensemble_outputs.h"
+#include "tools/chorus/flag_checks.h"
 
 namespace chorus::cli {
 namespace {
@@ -102,11 +105,13 @@ void runDenoise(const DenoiseArgs& args) {
     combiners.push_back(parseCombiner(name));
   const CombineOptions options = args.ensemble.options();
   const fs::path out = args.out;
+  const OwnedDirectory owned(out);  // one run at a time in DIR
 
   LoadedInput input = loadInput(args.input, specs);
   std::optional<Image> reference;
   if (!args.reference.empty()) {
     reference = readRgbExr(args.reference);
+    requireFinitePixels(*reference, args.reference);
     checkReferenceSize(*reference, args.reference, input.guides.width(), input.guides.height());
   }
   for (Combiner c : combiners)
@@ -173,7 +178,7 @@ const RegisterCommand registration(40, [](CLI::App& app) {
                   "Comma-separated base denoisers: built-in specs (name or name:key=value) for a "
                   "render.exr or Tungsten directory, folder names for a directory of outputs")
       ->required();
-  cmd->add_option("--out", args->out, "Output directory")->required();
+  cmd->add_option("--out", args->out, "Output directory")->required()->transform(nonEmpty());
   cmd->add_option("--combine", args->combine,
                   "Combiner, or a comma-separated list: ensemble, average, onehot-pre, "
                   "onehot-post, oracle, oracle-unconstrained (oracles need --reference)")

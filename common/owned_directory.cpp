@@ -22,8 +22,8 @@ namespace {
 constexpr const char* kLockFile = ".chorus.lock";
 constexpr const char* kFileList = ".chorus-files";
 constexpr const char* kStatsFile = "stats.json";
-// Each retry means another run removed its lock file between our open() and flock(): it
-// finished, so the next attempt normally succeeds.
+// Each retry means another run removed its lock file (or its empty directory) between our
+// open() and flock(): it finished, so the next attempt normally succeeds.
 constexpr int kLockAttempts = 100;
 
 // The pid a lock holder wrote into the lock file ("" while it has not yet).
@@ -76,8 +76,8 @@ OwnedDirectory::OwnedDirectory(fs::path dir, const std::vector<std::string>& cle
                                   (pid.empty() ? std::string() : " (pid " + pid + ")"));
       throw fileError(dir_, std::string("cannot lock: ") + std::strerror(error));
     }
-    // The holder we waited for may have removed the file we opened: locking that inode owns
-    // nothing, so check that the path still names it.
+    // The previous holder may have removed the file between our open() and flock(): locking
+    // that inode owns nothing, so check that the path still names it.
     struct stat opened {
     }, named{};
     if (::fstat(fd, &opened) != 0 || ::stat(lockPath.c_str(), &named) != 0 ||

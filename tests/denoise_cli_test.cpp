@@ -148,7 +148,7 @@ TEST(DenoiseCli, CleanFailures) {
   expectOneLine({in, "--methods", "box1", "--mse", "diagonal", "--out", out.string()},
                 "unknown --mse");
   expectOneLine({in, "--methods", "box1", "--noisy-fallback", "0.5", "--out", out.string()},
-                "--noisy-fallback must be 0 (off) or at least 1");
+                "--noisy-fallback: must be 0 (off) or a number in [1, 1e+06]");
   expectOneLine({(f.dir / "nothing").string(), "--methods", "box1", "--out", out.string()},
                 "no such file or directory");
   // A method file of another size.

@@ -65,8 +65,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
       laneTracer.reset();
   }
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
-  Film film =
-      arena.execute([&] { return Film(resolution.width, resolution.height, options.splits); });
+  Film film = arena.execute(
+      [&] { return Film(resolution.width, resolution.height, options.splits, options.planes); });
 
   const int tilesX = (resolution.width + kTileSize - 1) / kTileSize;
   const int tilesY = (resolution.height + kTileSize - 1) / kTileSize;

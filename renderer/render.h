@@ -37,6 +37,9 @@ struct RenderOptions {
   // area has a material no texture varies, else PathTracer one path at a time.
   enum class Tracer { Automatic, Lanes, OnePath };
   Tracer tracer = Tracer::Automatic;
+  // The planes the sub-buffers record (colour always): what the denoisers will read. The planes
+  // kept are bit-identical whatever the others are.
+  BufferPlanes planes = BufferPlanes::all();
 };
 
 struct RenderStats {

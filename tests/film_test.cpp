@@ -126,6 +126,42 @@ TEST(Film, MergingSubBuffersEqualsAccumulatingTogether) {
     }
 }
 
+// A film that records fewer planes stores the same bits in those it records and leaves the others
+// empty.
+TEST(Film, RecordsOnlyThePlanesAskedForWithTheSameBits) {
+  const BufferPlanes planes = BufferPlanes::colorOnly()
+                                  .with(Quantity::Normal, Plane::Mean)
+                                  .with(Quantity::Depth, Plane::Variance);
+  std::mt19937 rng(5);
+  Film all(3, 2, 2), some(3, 2, 2, planes);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 3; ++x) {
+      PixelAccumulator pixel;
+      for (int i = 0; i < 7; ++i) pixel.add(i % 2, randomSample(rng));
+      all.store(x, y, pixel);
+      some.store(x, y, pixel);
+    }
+  const SampleBuffers a = all.release(), s = some.release();
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(s.sub(k).planes(), planes);
+    EXPECT_TRUE(s.sub(k).albedo.mean.empty());
+    EXPECT_TRUE(s.sub(k).visibility.mean.empty());
+    EXPECT_TRUE(s.sub(k).normal.varianceOfMean.empty());
+    for (Quantity q : kAllQuantities)
+      for (bool variance : {false, true}) {
+        const Image& kept = variance ? s.sub(k).get(q).varianceOfMean : s.sub(k).get(q).mean;
+        const Image& full = variance ? a.sub(k).get(q).varianceOfMean : a.sub(k).get(q).mean;
+        if (kept.empty()) continue;
+        EXPECT_TRUE(std::equal(kept.values().begin(), kept.values().end(), full.values().begin(),
+                               full.values().end()))
+            << quantityName(q) << (variance ? " variance" : "");
+      }
+    EXPECT_TRUE(std::equal(s.sub(k).sampleCount.values().begin(),
+                           s.sub(k).sampleCount.values().end(),
+                           a.sub(k).sampleCount.values().begin()));
+  }
+}
+
 TEST(Film, MovingBuffersIntoExrLayersGivesTheSameLayersAsCopying) {
   std::mt19937 rng(19);
   Film film(3, 2, 4);

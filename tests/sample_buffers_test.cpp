@@ -139,10 +139,111 @@ TEST(SampleBuffers, RenderExrLayoutRoundTrips) {
       EXPECT_EQ(back.sub(k).get(q).varianceOfMean.values()[2],
                 raw.buffers.sub(k).get(q).varianceOfMean.values()[2]);
     }
-  // The default layer is the full-buffer colour.
+  // The default layer is the full-buffer colour; the rest of the full buffer is not stored (it
+  // is the merge of the sub-buffers).
   EXPECT_EQ(readExrLayer(dir / "render.exr").values()[4],
             raw.buffers.part(BufferPart::Full).color.mean.values()[4]);
+  const std::vector<ExrLayer> layers = readExr(dir / "render.exr");
+  EXPECT_EQ(layers.size(), 1 + 4 * 11u);  // per sub-buffer: 5 means, 5 variances, the count
+  EXPECT_EQ(findLayer(layers, "albedo"), nullptr);
+  EXPECT_EQ(findLayer(layers, "colorVariance"), nullptr);
   EXPECT_THROW(sampleBuffersFromLayers({{"", Image(2, 2, 3)}}, "x.exr"), Error);
+}
+
+// The buffers with only `planes` (the others emptied).
+SampleBuffers withPlanes(const SampleBuffers& buffers, BufferPlanes planes) {
+  std::vector<SubBuffer> subs = buffers.subBuffers();
+  for (SubBuffer& sub : subs)
+    for (Quantity q : kAllQuantities) {
+      if (!planes.has(q, Plane::Mean)) sub.get(q).mean = Image();
+      if (!planes.has(q, Plane::Variance)) sub.get(q).varianceOfMean = Image();
+    }
+  return SampleBuffers(std::move(subs));
+}
+
+bool sameBits(const Image& a, const Image& b) {
+  return a.sameSize(b) && std::equal(a.values().begin(), a.values().end(), b.values().begin());
+}
+
+TEST(SampleBuffers, PlanesNameWhatIsHeldAndAVarianceComesWithItsMean) {
+  EXPECT_EQ(BufferPlanes::all().list(),
+            "albedo, albedo variance, normal, normal variance, depth, depth variance, "
+            "visibility, visibility variance");
+  EXPECT_EQ(BufferPlanes::colorOnly().list(), "");
+  const BufferPlanes p = BufferPlanes::colorOnly().with(Quantity::Depth, Plane::Variance);
+  EXPECT_TRUE(p.has(Quantity::Depth, Plane::Mean));
+  EXPECT_EQ(p.list(), "depth, depth variance");
+  EXPECT_TRUE(BufferPlanes::all().contains(p));
+  EXPECT_FALSE(p.contains(BufferPlanes::all()));
+  EXPECT_EQ(BufferPlanes::all().minus(p).names().size(), 6u);
+  EXPECT_EQ(SubBuffer::zeros(3, 2, p).planes(), p);
+  EXPECT_TRUE(SubBuffer::zeros(3, 2, p).visibility.mean.empty());
+  EXPECT_EQ(SubBuffer::zeros(3, 2).planes(), BufferPlanes::all());
+}
+
+// Sub-buffers holding fewer planes merge and round-trip through render.exr to the same bits in
+// the planes they hold.
+TEST(SampleBuffers, BuffersWithFewerPlanesMergeAndRoundTripToTheSameBits) {
+  const RawBuffers raw = makeRaw(6, 5, 4);
+  const BufferPlanes planes = BufferPlanes::colorOnly()
+                                  .with(Quantity::Albedo, Plane::Mean)
+                                  .with(Quantity::Depth, Plane::Variance);
+  const SampleBuffers some = withPlanes(raw.buffers, planes);
+  const SubBuffer fullAll = raw.buffers.part(BufferPart::Full);
+  const SubBuffer fullSome = some.part(BufferPart::Full);
+  EXPECT_EQ(fullSome.planes(), planes);
+  for (Quantity q : {Quantity::Color, Quantity::Albedo, Quantity::Depth})
+    EXPECT_TRUE(sameBits(fullAll.get(q).mean, fullSome.get(q).mean)) << quantityName(q);
+  for (Quantity q : {Quantity::Color, Quantity::Depth})
+    EXPECT_TRUE(sameBits(fullAll.get(q).varianceOfMean, fullSome.get(q).varianceOfMean));
+  EXPECT_TRUE(sameBits(fullAll.sampleCount, fullSome.sampleCount));
+
+  test::TempDir dir;
+  for (int k : {1, 4}) {
+    const SampleBuffers buffers =
+        k == 4 ? some : SampleBuffers(std::vector<SubBuffer>{some.sub(0)});
+    const auto file = dir / ("k" + std::to_string(k) + ".exr");
+    writeExr(file, sampleBuffersToLayers(buffers));
+    const std::vector<ExrLayer> layers = readExr(file);
+    const std::string prefix = k == 4 ? "sub0." : "";
+    EXPECT_NE(findLayer(layers, prefix + "albedo"), nullptr);
+    EXPECT_EQ(findLayer(layers, prefix + "albedoVariance"), nullptr);
+    EXPECT_EQ(findLayer(layers, prefix + "visibility"), nullptr);
+    const SampleBuffers back = sampleBuffersFromLayers(layers, file);
+    ASSERT_EQ(back.splitCount(), k);
+    for (int s = 0; s < k; ++s) {
+      EXPECT_EQ(back.sub(s).planes(), planes);
+      for (Quantity q : kAllQuantities) {
+        EXPECT_TRUE(sameBits(back.sub(s).get(q).mean, buffers.sub(s).get(q).mean));
+        EXPECT_TRUE(
+            sameBits(back.sub(s).get(q).varianceOfMean, buffers.sub(s).get(q).varianceOfMean));
+      }
+    }
+  }
+  // Sub-buffers that differ in planes cannot merge.
+  std::vector<SubBuffer> mixed = {raw.buffers.sub(0), some.sub(1)};
+  EXPECT_THROW(SampleBuffers(std::move(mixed)).part(BufferPart::Full), std::invalid_argument);
+}
+
+TEST(SampleBuffers, ReadingRefusesAVarianceWithoutItsMeanAndSubBuffersThatDiffer) {
+  const RawBuffers raw = makeRaw(3, 2, 2);
+  std::vector<ExrLayer> layers = sampleBuffersToLayers(raw.buffers);
+  std::erase_if(layers, [](const ExrLayer& l) { return l.name == "sub1.depth"; });
+  try {
+    sampleBuffersFromLayers(layers, "r.exr");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "r.exr: layer 'sub1.depthVariance' without 'sub1.depth'");
+  }
+  std::erase_if(layers, [](const ExrLayer& l) { return l.name == "sub1.depthVariance"; });
+  try {
+    sampleBuffersFromLayers(layers, "r.exr");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "r.exr: sub-buffers hold different layers");
+  }
+  std::erase_if(layers, [](const ExrLayer& l) { return l.name == "sub0.colorVariance"; });
+  EXPECT_THROW(sampleBuffersFromLayers(layers, "r.exr"), Error);
 }
 
 }  // namespace

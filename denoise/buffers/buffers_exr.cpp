@@ -1,6 +1,8 @@
 #include "denoise/buffers/buffers_exr.h"
 
 #include <string>
+#include <type_traits>
+#include <utility>
 
 #include "common/error.h"
 
@@ -8,51 +10,73 @@ namespace chorus {
 
 namespace {
 
-void appendSubBuffer(std::vector<ExrLayer>& layers, const SubBuffer& sub,
-                     const std::string& prefix) {
-  for (Quantity q : kAllQuantities) {
-    const std::string name = std::string(quantityName(q));
-    const bool defaultLayer = prefix.empty() && q == Quantity::Color;
-    layers.push_back({defaultLayer ? "" : prefix + name, sub.get(q).mean});
-    layers.push_back({prefix + name + "Variance", sub.get(q).varianceOfMean});
-  }
-  layers.push_back({prefix + "sampleCount", sub.sampleCount});
+// The layer name of a plane of the buffer with this prefix ("" for K = 1, "sub<k>." else).
+std::string layerName(const std::string& prefix, Quantity q, Plane p) {
+  const std::string name = std::string(quantityName(q));
+  if (p == Plane::Variance) return prefix + name + "Variance";
+  // The unprefixed colour mean is the default layer, what viewers show first.
+  return prefix.empty() && q == Quantity::Color ? "" : prefix + name;
 }
 
-void appendSubBuffer(std::vector<ExrLayer>& layers, SubBuffer&& sub, const std::string& prefix) {
+// Appends the planes `sub` holds: copied from a const sub-buffer, moved out of a mutable one.
+template <typename Sub>
+void appendSubBuffer(std::vector<ExrLayer>& layers, Sub& sub, const std::string& prefix) {
+  const auto take = [](auto& image) -> Image {
+    if constexpr (std::is_const_v<Sub>)
+      return image;
+    else
+      return std::move(image);
+  };
   for (Quantity q : kAllQuantities) {
-    const std::string name = std::string(quantityName(q));
-    const bool defaultLayer = prefix.empty() && q == Quantity::Color;
-    layers.push_back({defaultLayer ? "" : prefix + name, std::move(sub.get(q).mean)});
-    layers.push_back({prefix + name + "Variance", std::move(sub.get(q).varianceOfMean)});
+    auto& planes = sub.get(q);
+    if (!planes.mean.empty())
+      layers.push_back({layerName(prefix, q, Plane::Mean), take(planes.mean)});
+    if (!planes.varianceOfMean.empty())
+      layers.push_back({layerName(prefix, q, Plane::Variance), take(planes.varianceOfMean)});
   }
-  layers.push_back({prefix + "sampleCount", std::move(sub.sampleCount)});
+  layers.push_back({prefix + "sampleCount", take(sub.sampleCount)});
 }
 
-const Image& requireLayer(const std::vector<ExrLayer>& layers, const std::string& name,
-                          int channels, const std::filesystem::path& file) {
+const Image* findPlane(const std::vector<ExrLayer>& layers, const std::string& name, int channels,
+                       const std::filesystem::path& file) {
   const ExrLayer* layer = findLayer(layers, name);
-  if (!layer)
-    throw fileError(file, "missing layer '" + (name.empty() ? "<default>" : name) +
-                              "' (not a chorus render.exr?)");
+  if (!layer) return nullptr;
   if (layer->image.channels() != channels)
     throw fileError(file, "layer '" + name + "' has " + std::to_string(layer->image.channels()) +
                               " channels, expected " + std::to_string(channels));
-  return layer->image;
+  return &layer->image;
+}
+
+const Image& requirePlane(const std::vector<ExrLayer>& layers, const std::string& name,
+                          int channels, const std::filesystem::path& file) {
+  const Image* image = findPlane(layers, name, channels, file);
+  if (!image)
+    throw fileError(file, "missing layer '" + (name.empty() ? "<default>" : name) +
+                              "' (not a chorus render.exr?)");
+  return *image;
 }
 
 SubBuffer readSubBuffer(const std::vector<ExrLayer>& layers, const std::string& prefix,
                         const std::filesystem::path& file) {
   SubBuffer sub;
   for (Quantity q : kAllQuantities) {
-    const std::string name = std::string(quantityName(q));
-    const bool defaultLayer = prefix.empty() && q == Quantity::Color;
-    sub.get(q).mean =
-        requireLayer(layers, defaultLayer ? "" : prefix + name, channelCount(q), file);
-    sub.get(q).varianceOfMean =
-        requireLayer(layers, prefix + name + "Variance", channelCount(q), file);
+    const std::string meanName = layerName(prefix, q, Plane::Mean);
+    const std::string varianceName = layerName(prefix, q, Plane::Variance);
+    const int channels = channelCount(q);
+    MeanVariance& planes = sub.get(q);
+    if (q == Quantity::Color) {
+      planes.mean = requirePlane(layers, meanName, channels, file);
+      planes.varianceOfMean = requirePlane(layers, varianceName, channels, file);
+      continue;
+    }
+    if (const Image* mean = findPlane(layers, meanName, channels, file)) planes.mean = *mean;
+    if (const Image* variance = findPlane(layers, varianceName, channels, file)) {
+      if (planes.mean.empty())
+        throw fileError(file, "layer '" + varianceName + "' without '" + meanName + "'");
+      planes.varianceOfMean = *variance;
+    }
   }
-  sub.sampleCount = requireLayer(layers, prefix + "sampleCount", 1, file);
+  sub.sampleCount = requirePlane(layers, prefix + "sampleCount", 1, file);
   return sub;
 }
 
@@ -60,19 +84,25 @@ SubBuffer readSubBuffer(const std::vector<ExrLayer>& layers, const std::string& 
 
 std::vector<ExrLayer> sampleBuffersToLayers(const SampleBuffers& buffers) {
   std::vector<ExrLayer> layers;
-  appendSubBuffer(layers, buffers.part(BufferPart::Full), "");
-  if (buffers.splitCount() > 1)
-    for (int k = 0; k < buffers.splitCount(); ++k)
-      appendSubBuffer(layers, buffers.sub(k), "sub" + std::to_string(k) + ".");
+  if (buffers.splitCount() == 1) {
+    appendSubBuffer(layers, buffers.sub(0), "");
+    return layers;
+  }
+  layers.push_back({"", buffers.part(BufferPart::Full).color.mean});
+  for (int k = 0; k < buffers.splitCount(); ++k)
+    appendSubBuffer(layers, buffers.sub(k), "sub" + std::to_string(k) + ".");
   return layers;
 }
 
 std::vector<ExrLayer> sampleBuffersToLayers(SampleBuffers&& buffers) {
   std::vector<ExrLayer> layers;
-  appendSubBuffer(layers, buffers.part(BufferPart::Full), "");
-  if (buffers.splitCount() > 1)
+  if (buffers.splitCount() == 1) {
+    appendSubBuffer(layers, buffers.sub(0), "");
+  } else {
+    layers.push_back({"", buffers.part(BufferPart::Full).color.mean});
     for (int k = 0; k < buffers.splitCount(); ++k)
-      appendSubBuffer(layers, std::move(buffers.sub(k)), "sub" + std::to_string(k) + ".");
+      appendSubBuffer(layers, buffers.sub(k), "sub" + std::to_string(k) + ".");
+  }
   buffers = SampleBuffers();
   return layers;
 }
@@ -86,9 +116,12 @@ SampleBuffers sampleBuffersFromLayers(const std::vector<ExrLayer>& layers,
     subs.push_back(readSubBuffer(layers, prefix, fileForErrors));
   }
   if (subs.empty()) subs.push_back(readSubBuffer(layers, "", fileForErrors));
-  for (const SubBuffer& s : subs)
+  for (const SubBuffer& s : subs) {
     if (s.width() != subs[0].width() || s.height() != subs[0].height())
       throw fileError(fileForErrors, "sub-buffers differ in size");
+    if (s.planes() != subs[0].planes())
+      throw fileError(fileForErrors, "sub-buffers hold different layers");
+  }
   return SampleBuffers(std::move(subs));
 }
 

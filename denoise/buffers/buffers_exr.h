@@ -1,15 +1,21 @@
 #pragma once
 // The layer layout of `render.exr`: SampleBuffers <-> EXR layers.
 //
-//   ""                     full-buffer colour mean (RGB), what viewers show first
-//   colorVariance          its variance of the mean
-//   albedo, normal         RGB / XYZ (stored as R G B) means of the full buffer
-//   depth, visibility      1 channel (Y)
-//   <q>Variance            variance of the mean of each of the above
-//   sampleCount            samples per pixel (Y)
-//   sub<k>.<q>, sub<k>.<q>Variance, sub<k>.sampleCount   the same for sub-buffer k = 0 … K−1
+//   sub<k>.color, sub<k>.colorVariance   colour mean (RGB) of sub-buffer k = 0 … K−1 and its
+//                                        variance of the mean
+//   sub<k>.albedo, sub<k>.normal         RGB / XYZ (stored as R G B) feature means
+//   sub<k>.depth, sub<k>.visibility      1 channel (Y)
+//   sub<k>.<q>Variance                   variance of the mean of each feature
+//   sub<k>.sampleCount                   samples per pixel (Y)
+//   ""                                   the full buffer's colour mean (RGB), what viewers show
+//                                        first; the rest of the full buffer is the exact merge
+//                                        of the sub-buffers and is not stored
 //
-// Reading takes the sub-buffers when present (exact), otherwise the full-buffer layers as K = 1.
+// With K = 1 the one buffer's layers carry no prefix: "" is its colour mean, then colorVariance,
+// albedo, … as above. Features are stored when the buffers hold them (BufferPlanes): a render
+// for members that read fewer features has fewer layers. Reading takes the sub-buffers when
+// present, otherwise the unprefixed layers as K = 1; colour and the sample count are required,
+// each feature plane is read when present.
 #include <filesystem>
 #include <vector>
 
@@ -22,6 +28,9 @@ std::vector<ExrLayer> sampleBuffersToLayers(const SampleBuffers& buffers);
 // The same, moving the sub-buffers' images into the layers instead of copying them (halves the
 // peak memory of writing a large render; `buffers` is left empty).
 std::vector<ExrLayer> sampleBuffersToLayers(SampleBuffers&& buffers);
+// Throws chorus::Error naming `fileForErrors` when colour or a sample count is missing, a layer
+// has the wrong channel count, a variance is stored without its mean, or the sub-buffers differ
+// in size or in the planes they hold.
 SampleBuffers sampleBuffersFromLayers(const std::vector<ExrLayer>& layers,
                                       const std::filesystem::path& fileForErrors);
 

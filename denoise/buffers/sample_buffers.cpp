@@ -40,14 +40,57 @@ std::string_view partName(BufferPart part) {
   return "?";
 }
 
-SubBuffer SubBuffer::zeros(int width, int height) {
+BufferPlanes BufferPlanes::all() {
+  BufferPlanes planes;
+  for (Quantity q : kAllQuantities) planes = planes.with(q, Plane::Variance);
+  return planes;
+}
+
+BufferPlanes BufferPlanes::colorOnly() {
+  return BufferPlanes().with(Quantity::Color, Plane::Variance);
+}
+
+BufferPlanes BufferPlanes::with(Quantity q, Plane p) const {
+  const uint16_t added = p == Plane::Variance ? bit(q, Plane::Mean) | bit(q, p) : bit(q, p);
+  return fromBits(uint16_t(bits_ | added));
+}
+
+std::vector<std::string> BufferPlanes::names() const {
+  std::vector<std::string> names;
+  for (Quantity q : kAllQuantities) {
+    if (q == Quantity::Color) continue;
+    for (Plane p : {Plane::Mean, Plane::Variance})
+      if (has(q, p))
+        names.push_back(std::string(quantityName(q)) + (p == Plane::Variance ? " variance" : ""));
+  }
+  return names;
+}
+
+std::string BufferPlanes::list() const {
+  std::string text;
+  for (const std::string& name : names()) text += (text.empty() ? "" : ", ") + name;
+  return text;
+}
+
+SubBuffer SubBuffer::zeros(int width, int height, BufferPlanes planes) {
+  planes = planes | BufferPlanes::colorOnly();
   SubBuffer s;
   for (Quantity q : kAllQuantities) {
-    s.get(q).mean = Image(width, height, channelCount(q));
-    s.get(q).varianceOfMean = Image(width, height, channelCount(q));
+    if (planes.has(q, Plane::Mean)) s.get(q).mean = Image(width, height, channelCount(q));
+    if (planes.has(q, Plane::Variance))
+      s.get(q).varianceOfMean = Image(width, height, channelCount(q));
   }
   s.sampleCount = Image(width, height, 1);
   return s;
+}
+
+BufferPlanes SubBuffer::planes() const {
+  BufferPlanes planes;
+  for (Quantity q : kAllQuantities) {
+    if (!get(q).mean.empty()) planes = planes.with(q, Plane::Mean);
+    if (!get(q).varianceOfMean.empty()) planes = planes.with(q, Plane::Variance);
+  }
+  return planes;
 }
 
 MeanVariance& SubBuffer::get(Quantity q) {
@@ -73,12 +116,15 @@ const MeanVariance& SubBuffer::get(Quantity q) const {
 SubBuffer merge(const std::vector<const SubBuffer*>& parts) {
   if (parts.empty()) throw std::invalid_argument("merge: no sub-buffers");
   const int w = parts[0]->width(), h = parts[0]->height();
-  for (const SubBuffer* p : parts)
+  const BufferPlanes planes = parts[0]->planes();
+  for (const SubBuffer* p : parts) {
     if (p->width() != w || p->height() != h)
       throw std::invalid_argument("merge: sub-buffers differ in size");
+    if (p->planes() != planes) throw std::invalid_argument("merge: sub-buffers differ in planes");
+  }
   if (parts.size() == 1) return *parts[0];
 
-  SubBuffer out = SubBuffer::zeros(w, h);
+  SubBuffer out = SubBuffer::zeros(w, h, planes);
   const size_t pixels = size_t(w) * size_t(h);
   const size_t count = parts.size();
   // Direct form of the merge: mean = Σ n_k mean_k / N, M2 = Σ (M2_k + n_k (mean_k − mean)²),
@@ -105,6 +151,8 @@ SubBuffer merge(const std::vector<const SubBuffer*>& parts) {
     // parts through pointer tables was a third of the merge's time).
     std::vector<double> mean, m2;
     for (Quantity q : kAllQuantities) {
+      if (!planes.has(q, Plane::Mean)) continue;
+      const bool variance = planes.has(q, Plane::Variance);
       const size_t channels = size_t(channelCount(q)), values = size * channels;
       const size_t offset = first * channels;
       mean.assign(values, 0.0);
@@ -119,7 +167,7 @@ SubBuffer merge(const std::vector<const SubBuffer*>& parts) {
           }
         }
       }
-      for (size_t k = 0; k < count;
+      for (size_t k = 0; variance && k < count;
            ++k) {  // M2_k = V_k n_k (n_k − 1), V_k its variance of the mean
         const float* partMean = parts[k]->get(q).mean.data() + offset;
         const float* partVariance = parts[k]->get(q).varianceOfMean.data() + offset;
@@ -134,11 +182,12 @@ SubBuffer merge(const std::vector<const SubBuffer*>& parts) {
         }
       }
       float* outMean = out.get(q).mean.data() + offset;
+      for (size_t e = 0; e < values; ++e) outMean[e] = float(mean[e]);
+      if (!variance) continue;
       float* outVariance = out.get(q).varianceOfMean.data() + offset;
       for (size_t i = 0; i < size; ++i)
         for (size_t c = 0; c < channels; ++c) {
           const size_t e = i * channels + c;
-          outMean[e] = float(mean[e]);
           outVariance[e] = float(m2[e] * varianceScale[i]);
         }
     }

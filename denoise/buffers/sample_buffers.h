@@ -4,7 +4,9 @@
 // feature, plus its sample count. Denoisers never see SampleBuffers directly: they get a
 // DenoiseInput (the buffer to denoise plus, when available, two independent halves of it).
 #include <array>
+#include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -29,22 +31,59 @@ int channelCount(Quantity q);
 // "color", "albedo", "normal", "depth", "visibility" (the names used in files and on the CLI).
 std::string_view quantityName(Quantity q);
 
+// Which planes a sub-buffer holds: the mean and the variance of the mean of each quantity. Colour
+// (mean and variance) is always held; a render for members that read fewer features records only
+// what they read (a plane not held is an empty image), and a variance is held only with its mean.
+enum class Plane { Mean, Variance };
+class BufferPlanes {
+ public:
+  static BufferPlanes all();
+  static BufferPlanes colorOnly();
+
+  bool has(Quantity q, Plane p) const { return (bits_ & bit(q, p)) != 0; }
+  // Adds a plane (a variance together with its mean).
+  BufferPlanes with(Quantity q, Plane p) const;
+  BufferPlanes operator|(BufferPlanes other) const { return fromBits(bits_ | other.bits_); }
+  bool contains(BufferPlanes other) const { return (other.bits_ & ~bits_) == 0; }
+  // The planes held here and not in `other` (for listing what is missing).
+  BufferPlanes minus(BufferPlanes other) const { return fromBits(uint16_t(bits_ & ~other.bits_)); }
+  bool operator==(const BufferPlanes&) const = default;
+  // {"albedo", "normal variance", "visibility"}: the feature planes held (colour left out: it
+  // is always held); list() joins them with ", ".
+  std::vector<std::string> names() const;
+  std::string list() const;
+
+ private:
+  static uint16_t bit(Quantity q, Plane p) {
+    return uint16_t(1u << (2 * int(q) + (p == Plane::Variance ? 1 : 0)));
+  }
+  static BufferPlanes fromBits(uint16_t bits) {
+    BufferPlanes planes;
+    planes.bits_ = bits;
+    return planes;
+  }
+  uint16_t bits_ = 0;
+};
+
 // One set of independent samples per pixel.
 struct SubBuffer {
   MeanVariance color, albedo, normal, depth, visibility;
   Image sampleCount;  // 1 channel: samples accumulated per pixel (non-finite samples dropped)
 
-  // An all-zero sub-buffer of the given size.
-  static SubBuffer zeros(int width, int height);
+  // An all-zero sub-buffer of the given size holding `planes` (the others empty).
+  static SubBuffer zeros(int width, int height, BufferPlanes planes = BufferPlanes::all());
 
   int width() const { return color.mean.width(); }
   int height() const { return color.mean.height(); }
   MeanVariance& get(Quantity q);
   const MeanVariance& get(Quantity q) const;
+  // The planes this sub-buffer holds (those that are not empty).
+  BufferPlanes planes() const;
 };
 
 // Exact merge of independent sub-buffers (Chan et al.'s parallel mean/M2 update, weighted by
-// sample counts): the result equals accumulating all their samples into one buffer.
+// sample counts): the result equals accumulating all their samples into one buffer. The parts
+// must hold the same planes; the result holds them too.
 SubBuffer merge(const std::vector<const SubBuffer*>& parts);
 
 // What a base denoiser runs on: the buffer to denoise and, when the source has them, two

@@ -41,14 +41,15 @@ bool PixelAccumulator::add(int k, const PathSample& sample) {
   return true;
 }
 
-Film::Film(int width, int height, int splits) : width_(width), height_(height) {
+Film::Film(int width, int height, int splits, BufferPlanes planes)
+    : width_(width), height_(height), planes_(planes | BufferPlanes::colorOnly()) {
   if (splits != 1 && splits != 2 && splits != 4)
     throw std::invalid_argument("Film: splits must be 1, 2 or 4");
   // Allocated and zeroed on as many threads as there are sub-buffers: the first touch of 24 MB
   // per sub-buffer at 512² was serial time in a 1-second preview.
   subBuffers_.resize(size_t(splits));
-  tbb::parallel_for(0, splits,
-                    [&](int k) { subBuffers_[size_t(k)] = SubBuffer::zeros(width, height); });
+  tbb::parallel_for(
+      0, splits, [&](int k) { subBuffers_[size_t(k)] = SubBuffer::zeros(width, height, planes_); });
 }
 
 void Film::store(int x, int y, const PixelAccumulator& pixel) {
@@ -56,21 +57,24 @@ void Film::store(int x, int y, const PixelAccumulator& pixel) {
     const PixelAccumulator::Stats& s = pixel.stats(int(k));
     SubBuffer& sub = subBuffers_[k];
     const double n = s.count;
-    const auto write = [&](MeanVariance& q, size_t first, int count) {
-      float* mean = q.mean.pixel(x, y);
-      float* variance = q.varianceOfMean.pixel(x, y);
-      for (int c = 0; c < count; ++c) {
-        mean[c] = float(s.mean[first + size_t(c)]);
-        // Clamped so that a finite but huge sample cannot overflow the float output.
-        const double v = n >= 2 ? s.m2[first + size_t(c)] / (n * (n - 1)) : 0.0;
-        variance[c] = float(std::min(v, double(std::numeric_limits<float>::max())));
+    size_t first = 0;  // the quantity's first channel in the accumulator, in kAllQuantities order
+    for (Quantity q : kAllQuantities) {
+      const int count = channelCount(q);
+      MeanVariance& planes = sub.get(q);
+      if (planes_.has(q, Plane::Mean)) {
+        float* mean = planes.mean.pixel(x, y);
+        for (int c = 0; c < count; ++c) mean[c] = float(s.mean[first + size_t(c)]);
       }
-    };
-    write(sub.color, 0, 3);
-    write(sub.albedo, 3, 3);
-    write(sub.normal, 6, 3);
-    write(sub.depth, 9, 1);
-    write(sub.visibility, 10, 1);
+      if (planes_.has(q, Plane::Variance)) {
+        float* variance = planes.varianceOfMean.pixel(x, y);
+        for (int c = 0; c < count; ++c) {
+          // Clamped so that a finite but huge sample cannot overflow the float output.
+          const double v = n >= 2 ? s.m2[first + size_t(c)] / (n * (n - 1)) : 0.0;
+          variance[c] = float(std::min(v, double(std::numeric_limits<float>::max())));
+        }
+      }
+      first += size_t(count);
+    }
     sub.sampleCount(x, y, 0) = float(s.count);
   }
 }

@@ -43,11 +43,13 @@ class PixelAccumulator {
 
 class Film {
  public:
-  // splits ∈ {1, 2, 4}.
-  Film(int width, int height, int splits);
+  // splits ∈ {1, 2, 4}; the sub-buffers hold `planes` (colour always; a feature only when a
+  // denoiser will read it: less to allocate, store and write).
+  Film(int width, int height, int splits, BufferPlanes planes = BufferPlanes::all());
 
   // Writes a finished pixel: mean, variance of the mean = M2 / (n (n − 1)) (0 when n < 2) and
-  // the sample count of every sub-buffer. Distinct pixels may be stored concurrently.
+  // the sample count of every sub-buffer, for the planes held. Distinct pixels may be stored
+  // concurrently.
   void store(int x, int y, const PixelAccumulator& pixel);
 
   int width() const { return width_; }
@@ -59,6 +61,7 @@ class Film {
 
  private:
   int width_, height_;
+  BufferPlanes planes_;
   std::vector<SubBuffer> subBuffers_;
 };
 

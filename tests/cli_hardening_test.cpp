@@ -111,6 +111,8 @@ const std::vector<BadFlag> kBadRenderFlags = {
     {"--reference", ""},
     {"--splits", "3"},
     {"--tracer", "fast"},
+    {"--keep", "everything"},
+    {"--keep", "members,"},
 };
 
 TEST(CliHardening, EveryBadRenderFlagIsOneLineNamingIt) {
@@ -144,8 +146,10 @@ TEST(CliHardening, EveryBadSweepAndDenoiseFlagIsOneLineNamingIt) {
   std::vector<std::string> args = sweep;
   args.insert(args.end(), {"--spp", "4,16777217"});
   expectRefused(args, "--spp '4,16777217': 16777217 is above 16777216", out);
-  for (const BadFlag& bad :
-       std::vector<BadFlag>{{"--out", ""}, {"--window", "1000000"}, {"--noisy-fallback", "nan"}})
+  for (const BadFlag& bad : std::vector<BadFlag>{{"--out", ""},
+                                                 {"--window", "1000000"},
+                                                 {"--noisy-fallback", "nan"},
+                                                 {"--keep", "render"}})
     expectRefused({"denoise", (dir / "render.exr").string(), "--methods", "atrous", "--out",
                    out.string(), bad.flag, bad.value},
                   bad.flag + ":", out);
@@ -320,7 +324,7 @@ TEST(CliHardening, ConcurrentRunsKillsAndReRendersLeaveOneRunsFiles) {
                                          "--quiet",  "--out",      out.string()};
   auto withDenoise = [&](const std::string& members) {
     std::vector<std::string> args = tiny;
-    args.insert(args.end(), {"--denoise", members});
+    args.insert(args.end(), {"--denoise", members, "--keep", "members,weights"});
     return args;
   };
   auto r = runChorus(withDenoise("atrous,jnlm"));

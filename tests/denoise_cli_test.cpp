@@ -60,9 +60,10 @@ struct OutputsFixture {
 TEST(DenoiseCli, OutputsDirectoryWithReference) {
   OutputsFixture f;
   const fs::path out = f.dir / "out";
-  const auto r = runChorus({"denoise", f.input.string(), "--methods", "box1,guided,nlm",
-                            "--combine", "ensemble,average,oracle", "--reference",
-                            f.reference.string(), "--out", out.string()});
+  const auto r =
+      runChorus({"denoise", f.input.string(), "--methods", "box1,guided,nlm", "--combine",
+                 "ensemble,average,oracle", "--reference", f.reference.string(), "--keep",
+                 "members,weights", "--out", out.string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   for (const char* name :
        {"ensemble.exr", "ensemble.png", "average.exr", "average.png", "oracle.exr", "weights.exr",
@@ -104,8 +105,8 @@ TEST(DenoiseCli, OptionsReachTheLibrary) {
   const fs::path out = f.dir / "out";
   const auto r = runChorus({"denoise", f.input.string(), "--methods", "box1,nlm", "--mse",
                             "per-channel", "--window", "0", "--weight-filter", "none", "--solver",
-                            "pairwise", "--solver-seed", "5", "--relative", "--noisy-fallback",
-                            "1.5", "--out", out.string()});
+                            "pairwise", "--solver-seed=5", "--relative", "--noisy-fallback", "1.5",
+                            "--keep=weights", "--out", out.string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   CombineOptions o;
   o.mse.noisyFallback = 1.5;
@@ -198,8 +199,8 @@ TEST(DenoiseCli, RenderExrWithRegisteredDenoisers) {
 
   TempDir dir("chorus_denoise_render");
   const fs::path render = writeRender(dir, 4), out = dir / "out";
-  const auto r =
-      runChorus({"denoise", render.string(), "--methods", methods, "--out", out.string()});
+  const auto r = runChorus({"denoise", render.string(), "--methods", methods, "--keep", "members",
+                            "--out", out.string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const json stats = readJson(out / "stats.json");
   EXPECT_EQ(stats["input_kind"], "render.exr");

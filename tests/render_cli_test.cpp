@@ -231,8 +231,8 @@ TEST(RenderCli, DenoisesInProcessLikeChorusDenoiseOnTheWrittenRender) {
   EXPECT_FALSE(std::filesystem::exists(out / "render.exr"));
   // The reference is the full-buffer colour layer of the high-spp render.exr.
   r = runChorus({"render", scene.string(), size[0], size[1], "--spp", "8", "--denoise",
-                 "atrous,jnlm", "--reference", (dir / "ref" / "render.exr").string(), "--out",
-                 out.string()});
+                 "atrous,jnlm", "--reference", (dir / "ref" / "render.exr").string(), "--keep",
+                 "members,weights", "--out", out.string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.err.find("denoised with atrous,jnlm (ensemble)"), std::string::npos) << r.err;
   for (const char* f : {"render.exr", "color.png", "denoised.exr", "denoised.png", "weights.exr",

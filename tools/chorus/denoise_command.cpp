@@ -6,8 +6,9 @@
 //       (color.exr, colorA.exr, colorB.exr, albedo.exr, normal.exr, <m>/<m>{,A,B}.exr).
 // --combine none (the default for a single method) runs each member alone on the full buffer:
 // DIR/<method>.exr/.png and DIR/stats.json. Any other combiner runs every member on half A,
-// half B and the full buffer and blends them: DIR/<combiner>.exr/.png, DIR/weights.exr,
-// DIR/<method>.exr and DIR/stats.json. docs/cli.md: which input can feed which member.
+// half B and the full buffer and blends them: DIR/<combiner>.exr/.png and DIR/stats.json, with
+// --keep weights DIR/weights.exr, with --keep members DIR/<method>.exr. docs/cli.md: which
+// input can feed which member.
 #include <nlohmann/json.hpp>
 
 #include <iostream>
@@ -28,10 +29,12 @@
 #include "denoise/buffers/tungsten_dir.h"
 #include "denoise/ensemble/outputs_directory.h"
 #include "denoise/pipeline/ensemble.h"
+#include "denoise/pipeline/member_planes.h"
 #include "tools/chorus/command.h"
 #include "tools/chorus/ensemble_flags.h"
 #include "tools/chorus/ensemble_outputs.h"
 #include "tools/chorus/flag_checks.h"
+#include "tools/chorus/kept_outputs.h"
 
 namespace chorus::cli {
 namespace {
@@ -44,6 +47,7 @@ struct DenoiseArgs {
   std::string combine;  // empty: ensemble, or none for a single method
   std::string reference;
   EnsembleFlags ensemble;
+  KeptOutputs keep;
 };
 
 // An input as read, before any member runs: the buffers built-in members run on (a render.exr's
@@ -102,6 +106,19 @@ std::string inputHint(const ReadInput& input, bool alone) {
   return "; run it alone on the full buffer with --combine none";
 }
 
+// Throws, naming the input, when a render.exr lacks a feature the members (and, `combined`, the
+// combination) read: it was rendered for members that read fewer.
+void checkFeaturesHeld(const ReadInput& input, const std::vector<EnsembleMember>& members,
+                       bool combined) {
+  if (!input.render) return;
+  try {
+    checkPlanesHeld(input.render->sub(0).planes(), members, combined);
+  } catch (const Error& e) {
+    throw fileError(input.path, e.what() + std::string(" (rendered for other members: render "
+                                                       "with --denoise none, or with these)"));
+  }
+}
+
 // Member outputs and the timings of their runs.
 struct MemberRuns {
   std::vector<BaseOutputs> bases;  // alone: only `full` is set
@@ -120,6 +137,7 @@ MemberRuns runAlone(ReadInput& input, const std::vector<std::string>& specs) {
   std::optional<DenoiseInput> merged;  // a render's full buffer and its halves A and B
   if (input.render) merged = input.render->input(BufferPart::Full);
   const DenoiseInput& full = merged ? *merged : *input.tungsten;
+  checkFeaturesHeld(input, members, false);
   try {
     checkMembersCanRunAlone(full, members);
   } catch (const Error& e) {
@@ -141,6 +159,7 @@ MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& spec
     return runs;
   }
   const std::vector<EnsembleMember> members = fileSafeMembers(specs);
+  checkFeaturesHeld(input, members, true);
   EnsembleSources sources;
   try {
     sources = input.render ? sourcesFromBuffers(*input.render) : sourcesFromHalves(*input.tungsten);
@@ -225,13 +244,17 @@ void runDenoise(const DenoiseArgs& args) {
     for (const StageTime& t : runs.times) times[t.stage] = t.seconds;
     ensureDirectory(out);
     const Stopwatch write;
+    std::vector<std::string> written;
     for (const BaseOutputs& base : runs.bases) {
       writeExr(out / (base.name + ".exr"), base.full);
       writePng(out / (base.name + ".png"), base.full);
+      written.insert(written.end(), {base.name + ".exr", base.name + ".png"});
       if (reference) metrics[base.name] = metricsJson(base.full, *reference);
       std::cout << "wrote " << (out / (base.name + ".exr")).string() << "\n";
     }
     times["write"] = write.seconds();
+    written.push_back("stats.json");
+    stats["outputs"] = outputsJson(written, {});  // the members' outputs are the result
     if (reference) stats["metrics"] = metrics;
     return writeStats(out, stats, times, total);
   }
@@ -243,6 +266,8 @@ void runDenoise(const DenoiseArgs& args) {
   ensureDirectory(out);
   stats["options"] = combineOptionsJson(options);
   stats["options"].erase("combine");  // one run per --combine value
+  std::vector<std::string> written;
+  std::vector<LeftOut> leftOut;
   for (size_t k = 0; k < combiners.size(); ++k) {
     CombineOptions o = options;
     o.combiner = combiners[k];
@@ -251,17 +276,34 @@ void runDenoise(const DenoiseArgs& args) {
         combine(guides, pointersTo(runs.bases), o, reference ? &*reference : nullptr);
     for (const StageTime& t : result.times) times[name + "/" + t.stage] = t.seconds;
     const Stopwatch write;
-    writeCombined(out, name, result, runs.bases,
-                  k == 0 ? "weights.exr" : "weights-" + name + ".exr");
+    writeCombined(out, name, result);
+    written.insert(written.end(), {name + ".exr", name + ".png"});
+    const std::string weightsFile = k == 0 ? "weights.exr" : "weights-" + name + ".exr";
+    if (args.keep.weights) {
+      writeWeights(out, weightsFile, result, runs.bases);
+      written.push_back(weightsFile);
+    } else {
+      leftOut.push_back({weightsFile, "--keep weights"});
+    }
     times[name + "/write"] = write.seconds();
     if (reference) metrics[name] = metricsJson(result.image, *reference);
     if (o.combiner == Combiner::Ensemble)
       stats["noisy_fallback_pixels"] = result.noisyFallbackPixels;
     std::cout << "wrote " << (out / (name + ".exr")).string() << "\n";
   }
-  const Stopwatch writeBases;
-  writeBaseOutputs(out, runs.bases);
-  times["write bases"] = writeBases.seconds();
+  if (args.keep.members) {
+    const Stopwatch writeBases;
+    writeBaseOutputs(out, runs.bases);
+    times["write bases"] = writeBases.seconds();
+  }
+  for (const BaseOutputs& base : runs.bases) {
+    if (args.keep.members)
+      written.push_back(base.name + ".exr");
+    else
+      leftOut.push_back({base.name + ".exr", "--keep members"});
+  }
+  written.push_back("stats.json");
+  stats["outputs"] = outputsJson(written, leftOut);
   if (reference) {
     for (const BaseOutputs& base : runs.bases)
       metrics[base.name] = metricsJson(base.full, *reference);
@@ -295,6 +337,7 @@ const RegisterCommand registration(40, [](CLI::App& app) {
                   "onehot-post, oracle, oracle-unconstrained (oracles need --reference). "
                   "Default: none for one method, else ensemble");
   args->ensemble.addFlags(*cmd);
+  args->keep.addFlag(*cmd);
   cmd->add_option("--reference", args->reference,
                   "Reference image (.exr): relMSE, DSSIM and PSNR of the noisy input, each member "
                   "and each combination in stats.json, and the oracle combiners");

@@ -59,17 +59,20 @@ nlohmann::ordered_json combineOptionsJson(const CombineOptions& o) {
 }
 
 void writeCombined(const std::filesystem::path& dir, const std::string& name,
-                   const CombineResult& result, const std::vector<BaseOutputs>& bases,
-                   const std::string& weightsFile) {
+                   const CombineResult& result) {
   writeExr(dir / (name + ".exr"), {{"", result.image},
                                    {"A", result.imageA},
                                    {"B", result.imageB},
                                    {"mseEstimate", result.mseEstimate}});
   writePng(dir / (name + ".png"), result.image);
+}
+
+void writeWeights(const std::filesystem::path& dir, const std::string& file,
+                  const CombineResult& result, const std::vector<BaseOutputs>& bases) {
   std::vector<ExrLayer> weights;
   for (size_t i = 0; i < bases.size(); ++i) weights.push_back({bases[i].name, result.weights[i]});
   if (!result.noisyFallback.empty()) weights.push_back({"noisyFallback", result.noisyFallback});
-  writeExr(dir / weightsFile, weights);
+  writeExr(dir / file, weights);
 }
 
 void writeBaseOutputs(const std::filesystem::path& dir, const std::vector<BaseOutputs>& bases) {

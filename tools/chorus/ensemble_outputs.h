@@ -1,7 +1,7 @@
 #pragma once
 // What `chorus denoise` and `chorus render --denoise` share: building members from method
 // specs, reading a reference, and writing a combined result, its weight maps and the base
-// outputs.
+// outputs (the last two only with --keep, kept_outputs.h).
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -28,11 +28,14 @@ nlohmann::ordered_json metricsJson(const Image& image, const Image& reference);
 // The options of a combination, for stats.json.
 nlohmann::ordered_json combineOptionsJson(const CombineOptions& options);
 
-// DIR/<name>.exr (layers: RGB = the blend, A, B, mseEstimate), DIR/<name>.png and the weight
-// maps as DIR/<weightsFile>, one layer per base.
+// DIR/<name>.exr (layers: RGB = the blend, A, B, mseEstimate) and DIR/<name>.png.
 void writeCombined(const std::filesystem::path& dir, const std::string& name,
-                   const CombineResult& result, const std::vector<BaseOutputs>& bases,
-                   const std::string& weightsFile);
+                   const CombineResult& result);
+
+// The weight maps as DIR/<file>: one layer per base, and noisyFallback (1 where the blend is the
+// noisy value) when the combiner has one.
+void writeWeights(const std::filesystem::path& dir, const std::string& file,
+                  const CombineResult& result, const std::vector<BaseOutputs>& bases);
 
 // DIR/<base>.exr for every base: RGB = the full-buffer output, layers A and B.
 void writeBaseOutputs(const std::filesystem::path& dir, const std::vector<BaseOutputs>& bases);

@@ -1,7 +1,8 @@
-// chorus render SCENE: path-trace a glTF scene into K independent sub-buffers, write
-// DIR/render.exr (every layer), DIR/color.png and DIR/stats.json, then (unless --denoise none)
-// denoise in the same process: DIR/denoised.exr/.png, weights.exr and one EXR per member.
-// --preview: 4 spp, the fast members, DIR/denoised.png and stats.json only.
+// chorus render SCENE: path-trace a glTF scene into K independent sub-buffers holding the
+// features the denoisers read, write DIR/render.exr, DIR/color.png and DIR/stats.json, then
+// (unless --denoise none) denoise in the same process: DIR/denoised.exr/.png, and with --keep
+// weights.exr and one EXR per member. --preview: 4 spp, the fast members, DIR/denoised.png and
+// stats.json only.
 #include <nlohmann/json.hpp>
 
 #include <iostream>
@@ -21,6 +22,7 @@
 #include "tools/chorus/ensemble_flags.h"
 #include "tools/chorus/ensemble_outputs.h"
 #include "tools/chorus/flag_checks.h"
+#include "tools/chorus/kept_outputs.h"
 #include "tools/chorus/memory_estimate.h"
 #include "tools/chorus/progress_bar.h"
 #include "tools/chorus/render_denoise.h"
@@ -39,6 +41,7 @@ struct RenderArgs {
   int splits = 0;             // 0: what the denoising stage needs
   std::string denoise = "default", combine = "ensemble", reference;
   EnsembleFlags ensemble;
+  KeptOutputs keep;
   bool preview = false, sppGiven = false, denoiseGiven = false;
   bool quiet = false;
 };
@@ -50,6 +53,7 @@ DenoiseStage denoiseStageOf(const RenderArgs& args) {
     applyPreviewDefaults(options, args.ensemble.weightFilterGiven, args.ensemble.imagePriorGiven);
   const std::string list = args.denoiseGiven ? args.denoise : args.preview ? "preview" : "default";
   DenoiseStage stage = DenoiseStage::parse(list, options, !args.preview);
+  stage.keep = args.keep;
   const int needed = stage.splitsNeeded();
   if (stage.enabled() && args.splits != 0 && args.splits < needed)
     throw Error("--denoise " + stage.label() + " needs " + std::to_string(needed) +
@@ -57,15 +61,17 @@ DenoiseStage denoiseStageOf(const RenderArgs& args) {
   return stage;
 }
 
-nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderStats& s,
-                                 const LoadedScene& loaded) {
-  const RenderOptions& options = args.sceneOptions.render;
+nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderOptions& options,
+                                 const RenderStats& s, const LoadedScene& loaded) {
   nlohmann::ordered_json j;
   j["scene"] = args.scene;
   j["width"] = s.width;
   j["height"] = s.height;
   j["spp"] = s.spp;
   j["splits"] = s.splits;
+  // The feature planes the sub-buffers hold, and those no member reads.
+  j["planes"] = {{"recorded", options.planes.names()},
+                 {"left_out", BufferPlanes::all().minus(options.planes).names()}};
   j["seed"] = options.seed;
   j["max_depth"] = options.maxDepth;
   j["roulette_depth"] = options.rouletteStartDepth;
@@ -95,13 +101,17 @@ std::vector<std::string> outputFiles(const RenderArgs& args, const DenoiseStage&
     files = {"render.exr", "color.png"};
   else if (!denoise.enabled())
     files = {"color.png"};
-  if (denoise.enabled() && denoise.writeExrs) {
-    files.insert(files.end(), {"denoised.exr", "denoised.png", "weights.exr"});
-    for (const EnsembleMember& member : denoise.members) files.push_back(member.label + ".exr");
-  } else if (denoise.enabled()) {
-    files.push_back("denoised.png");
-  }
+  const std::vector<std::string> denoised = denoise.files();
+  files.insert(files.end(), denoised.begin(), denoised.end());
   files.push_back("stats.json");
+  return files;
+}
+
+std::vector<LeftOut> leftOutFiles(const RenderArgs& args, const DenoiseStage& denoise) {
+  std::vector<LeftOut> files;
+  if (args.preview) files.push_back({"render.exr", "without --preview"});
+  const std::vector<LeftOut> denoised = denoise.leftOut();
+  files.insert(files.end(), denoised.begin(), denoised.end());
   return files;
 }
 
@@ -111,6 +121,7 @@ void runRender(RenderArgs args) {
   const DenoiseStage denoise = denoiseStageOf(args);
   RenderOptions options = args.sceneOptions.render;
   options.splits = args.splits > 0 ? args.splits : denoise.splitsNeeded();
+  options.planes = denoise.planesNeeded();
   std::optional<Image> reference;
   if (!args.reference.empty()) {
     if (!denoise.enabled()) throw Error("--reference needs --denoise");
@@ -142,7 +153,8 @@ void runRender(RenderArgs args) {
   // leaves them untouched; a run killed while writing leaves no stats.json).
   const std::vector<std::string> files = outputFiles(args, denoise);
   out.replacePreviousRun(files);
-  nlohmann::ordered_json stats = statsJson(args, result.stats, loaded);
+  nlohmann::ordered_json stats = statsJson(args, options, result.stats, loaded);
+  stats["outputs"] = outputsJson(files, leftOutFiles(args, denoise));
   // The denoisers' inputs are copies, so the buffers can move into render.exr's layers (no
   // second copy of a large render in memory), and render.exr is on disk before denoising. A
   // preview writes no render.exr: its inputs take the buffers over.
@@ -181,8 +193,9 @@ const RegisterCommand registration(30, [](CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand(
       "render",
-      "Path-trace a glTF scene into independent sub-buffers (colour, albedo, normal, "
-      "depth, visibility, with variances); writes DIR/render.exr, color.png, stats.json");
+      "Path-trace a glTF scene into independent sub-buffers (colour and the features the "
+      "denoisers read: albedo, normal, depth, visibility, with variances); writes "
+      "DIR/render.exr, color.png, stats.json and, unless --denoise none, denoised.exr/.png");
   cmd->add_option("scene", args->scene, "glTF scene (.gltf or .glb)")->required();
   cmd->add_option("--out", args->out, "Output directory")
       ->capture_default_str()
@@ -199,7 +212,7 @@ const RegisterCommand registration(30, [](CLI::App& app) {
   args->sceneOptions.addFlags(*cmd);
   cmd->add_option("--denoise", args->denoise,
                   std::string("Denoising after the render: none (render.exr keeps the "
-                              "sub-buffers the default members need), default (") +
+                              "sub-buffers and features the default members read), default (") +
                       kDefaultDenoise + "), preview (" + kPreviewDenoise +
                       ") or a comma-separated list of base denoisers (name or name:key=value; "
                       "`chorus denoise --help` lists them)")
@@ -211,12 +224,13 @@ const RegisterCommand registration(30, [](CLI::App& app) {
   cmd->add_flag("--preview", args->preview,
                 std::string("Fast preview: 4 spp unless --spp, members ") + kPreviewDenoise +
                     " unless --denoise, no weight filter unless --weight-filter, writes only "
-                    "denoised.png and stats.json");
+                    "denoised.png and stats.json (and what --keep lists)");
   cmd->add_option("--reference", args->reference,
                   "Reference image (.exr) of the same view: metrics of the noisy input, each "
                   "member and the result in stats.json")
       ->transform(nonEmpty());
   args->ensemble.addFlags(*cmd);
+  args->keep.addFlag(*cmd);
   cmd->add_flag("--quiet", args->quiet, "No progress bar or summary line");
   cmd->callback([args] { runRender(*args); });
 });

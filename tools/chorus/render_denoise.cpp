@@ -4,6 +4,7 @@
 #include "common/image/png_io.h"
 #include "common/stopwatch.h"
 #include "denoise/base/registry.h"
+#include "denoise/pipeline/member_planes.h"
 #include "tools/chorus/ensemble_outputs.h"
 
 namespace chorus::cli {
@@ -29,6 +30,7 @@ double DenoiseStage::run(const EnsembleSources& sources, const std::filesystem::
                          nlohmann::ordered_json& stats, const Image* reference) const {
   const Ensemble ensemble(members, options);
   checkMembersCanRun(sources, ensemble.members());
+  checkPlanesHeld(sources.full.whole.planes(), ensemble.members(), true);
   const Stopwatch denoise;
   const EnsembleResult result = ensemble.run(sources);
   const double denoiseSeconds = denoise.seconds();
@@ -36,12 +38,12 @@ double DenoiseStage::run(const EnsembleSources& sources, const std::filesystem::
   nlohmann::ordered_json& seconds = stats["seconds"];
   for (const StageTime& t : result.times) seconds[t.stage] = t.seconds;
   Stopwatch write;
-  if (writeExrs) {
-    writeCombined(dir, "denoised", result.combined, result.bases, "weights.exr");
-    writeBaseOutputs(dir, result.bases);
-  } else {
+  if (writeExrs)
+    writeCombined(dir, "denoised", result.combined);
+  else
     writePng(dir / "denoised.png", result.combined.image);
-  }
+  if (keep.weights) writeWeights(dir, "weights.exr", result.combined, result.bases);
+  if (keep.members) writeBaseOutputs(dir, result.bases);
   seconds["write denoised"] = write.seconds();
 
   stats["denoise"] = combineOptionsJson(options);
@@ -61,6 +63,33 @@ int DenoiseStage::splitsNeeded() const {
   if (enabled()) return chorus::splitsNeeded(members);
   if (!writeExrs) return 1;
   return chorus::splitsNeeded(fileSafeMembers(splitMethodList(kDefaultDenoise)));
+}
+
+BufferPlanes DenoiseStage::planesNeeded() const {
+  if (enabled()) return planesReadBy(members, true);
+  if (!writeExrs) return BufferPlanes::colorOnly();
+  return planesReadBy(fileSafeMembers(splitMethodList(kDefaultDenoise)), true);
+}
+
+std::vector<std::string> DenoiseStage::files() const {
+  if (!enabled()) return {};
+  std::vector<std::string> files = {"denoised.png"};
+  if (writeExrs) files.insert(files.begin(), "denoised.exr");
+  if (keep.weights) files.push_back("weights.exr");
+  if (keep.members)
+    for (const EnsembleMember& member : members) files.push_back(member.label + ".exr");
+  return files;
+}
+
+std::vector<LeftOut> DenoiseStage::leftOut() const {
+  std::vector<LeftOut> files;
+  if (!enabled()) return files;
+  if (!writeExrs) files.push_back({"denoised.exr", "without --preview"});
+  if (!keep.weights) files.push_back({"weights.exr", "--keep weights"});
+  if (!keep.members)
+    for (const EnsembleMember& member : members)
+      files.push_back({member.label + ".exr", "--keep members"});
+  return files;
 }
 
 std::string DenoiseStage::label() const {

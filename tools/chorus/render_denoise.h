@@ -12,6 +12,7 @@
 
 #include "denoise/ensemble/combiners.h"
 #include "denoise/pipeline/ensemble.h"
+#include "tools/chorus/kept_outputs.h"
 
 namespace chorus::cli {
 
@@ -36,6 +37,7 @@ struct DenoiseStage {
   std::vector<EnsembleMember> members;  // built from specs once, by parse()
   CombineOptions options;
   bool writeExrs = true;  // false for previews: denoised.png only
+  KeptOutputs keep;       // --keep: member outputs and weight maps
 
   // From a --denoise value ("none", "default", "preview" or a comma-separated list of method
   // specs). Throws chorus::Error for an unknown method or parameter.
@@ -47,11 +49,20 @@ struct DenoiseStage {
   // the default members need, so that `chorus denoise render.exr` can run them later (render
   // now, denoise later); 1 for a preview, which writes no render.exr.
   int splitsNeeded() const;
+  // The planes the render records: what the members and the combination read; without
+  // denoising, what the default members read (for a later `chorus denoise`); colour only for a
+  // preview without denoising.
+  BufferPlanes planesNeeded() const;
+
+  // The files run() writes, and those it leaves out for want of --keep (or, in a preview, of
+  // a full run).
+  std::vector<std::string> files() const;
+  std::vector<LeftOut> leftOut() const;
 
   // Runs the members and the combiner on `sources` (sourcesFromBuffers of the render),
-  // writes denoised.png and, unless a preview, denoised.exr, weights.exr and <member>.exr to
-  // `dir`, and adds every stage's seconds to stats["seconds"] and, with a reference, the
-  // metrics of the noisy input, each member and the result to stats["metrics"].
+  // writes files() to `dir` (denoised.png and, unless a preview, denoised.exr; weights.exr and
+  // <member>.exr with --keep), and adds every stage's seconds to stats["seconds"] and, with a
+  // reference, the metrics of the noisy input, each member and the result to stats["metrics"].
   // Returns the seconds of the members and the combiner (without writing).
   double run(const EnsembleSources& sources, const std::filesystem::path& dir,
              nlohmann::ordered_json& stats, const Image* reference) const;

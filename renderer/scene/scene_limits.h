@@ -38,7 +38,7 @@ inline constexpr double kBytesPerVertex = 32;
 // |coordinate| of every vertex, camera and punctual light after the node transforms. Embree
 // asserts that ray origins and directions stay below 1.844e18; the farthest origin chorus makes
 // from a scene within this bound is the framing camera's, at most √3 · 1e12 / sin(fov / 2)
-// ≈ 2.8e17 away for image aspects down to 1/65536.
+// ≈ 2.7e17 away for image aspects down to 1/65536.
 inline constexpr float kMaxCoordinate = 1e12f;
 // Camera aspect ratios (perspective aspectRatio, orthographic xmag / ymag): beyond these the
 // image size chosen from one side overflows rather than frames anything.

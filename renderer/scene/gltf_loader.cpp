@@ -1,7 +1,6 @@
 #include "renderer/scene/gltf_loader.h"
 
 #include <tiny_gltf.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -11,6 +10,7 @@
 #include <set>
 
 #include "common/error.h"
+#include "common/memory_budget.h"
 #include "renderer/math/transform.h"
 #include "renderer/scene/gltf_accessors.h"
 #include "renderer/scene/gltf_file.h"
@@ -64,23 +64,14 @@ void addToBudget(size_t* used, size_t amount, size_t limit, const std::string& w
   *used += amount;
 }
 
-// Infinite when the system does not say.
-double physicalMemoryBytes() {
-  static const double bytes = [] {
-    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
-    return pages > 0 && pageSize > 0 ? double(pages) * double(pageSize)
-                                     : std::numeric_limits<double>::infinity();
-  }();
-  return bytes;
-}
-
-void checkMemory(size_t triangles, size_t vertices) {
+// Throws chorus::Error (common/memory_budget.h) when the scene's geometry cannot fit in the
+// memory the machine has available.
+void checkMemory(size_t triangles, size_t vertices, uint64_t availableBytes) {
   const double needed = double(triangles) * kBytesPerTriangle + double(vertices) * kBytesPerVertex;
-  if (needed > physicalMemoryBytes())
-    throw Error("needs about " + shortNumber(needed / 1e9) + " GB of memory for " +
-                std::to_string(triangles) + " triangles and " + std::to_string(vertices) +
-                " vertices (instances included); this machine has " +
-                shortNumber(physicalMemoryBytes() / 1e9) + " GB");
+  checkMemoryBudget(uint64_t(needed),
+                    "loading " + std::to_string(triangles) + " triangles and " +
+                        std::to_string(vertices) + " vertices (instances included)",
+                    availableBytes);
 }
 
 // Triangles a primitive of `indexCount` indices makes in `mode`.
@@ -199,7 +190,7 @@ class SceneBuilder {
                                   : vertexCount;
     addToBudget(&triangles_, trianglesOf(indexCount, mode), kMaxSceneTriangles,
                 "triangles over all instances");
-    checkMemory(triangles_, vertices_);
+    checkMemory(triangles_, vertices_, availableBytes_);
 
     MeshDesc mesh;
     mesh.name = label;
@@ -346,6 +337,7 @@ class SceneBuilder {
   gltf::MaterialReader materials_;
   int skippedPrimitives_ = 0;
   size_t nodeInstances_ = 0, primitiveInstances_ = 0, triangles_ = 0, vertices_ = 0;
+  const uint64_t availableBytes_ = availableMemoryBytes();  // read once per scene
 };
 
 void checkExtensions(const tinygltf::Model& model, SceneDesc& out) {

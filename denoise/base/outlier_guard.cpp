@@ -29,12 +29,12 @@ float countAt(const SubBuffer& buffer, size_t i) {
   return buffer.sampleCount.sameSize(buffer.color.mean) ? buffer.sampleCount.data()[i] : 0.0f;
 }
 
-// Whether the pixel's own samples support an excess over the neighbourhood level: the excess
-// is more than `sigmas` standard errors of the mean. Fewer than 2 samples give no variance (0 by
+// Whether a pixel's samples support an excess over the neighbourhood level: the excess is more
+// than `sigmas` standard errors of the mean. Fewer than 2 samples give no variance (0 by
 // convention), so nothing is confirmed; an unknown count (0) trusts a positive variance.
 // A variance at FLT_MAX is saturated (the film clamps there: the square of a radiance above
 // ~1.8e19), a lower bound that confirms nothing.
-bool ownSamplesConfirm(double excess, float variance, float count, double sigmas) {
+bool samplesConfirm(double excess, float variance, float count, double sigmas) {
   const bool measured = count == 0.0f ? variance > 0.0f : count >= 2.0f;
   return measured && variance >= 0.0f && variance < kMaxFloat &&
          excess > sigmas * std::sqrt(double(variance));
@@ -57,6 +57,33 @@ double withoutLargestSample(double mean, float variance, float count, double lev
   return mean - std::sqrt(std::max(0.0, double(variance) - rest));
 }
 
+struct PixelStats {
+  double mean;
+  float variance;  // of the mean
+  float count;     // 0: unknown
+};
+
+// Colour channel c of pixel i of two independent buffers pooled (Chan et al.'s update, as in
+// merge()); equal weights when they record no sample counts, the variance then at least the
+// two-buffer estimate ¼ (m1 − m2)².
+PixelStats mergedAt(const SubBuffer& a, const SubBuffer& b, size_t i, int c) {
+  const double n0 = std::max(0.0f, countAt(a, i)), n1 = std::max(0.0f, countAt(b, i));
+  const double n = n0 + n1;
+  const size_t e = i * 3 + size_t(c);
+  const double m0 = a.color.mean.data()[e], m1 = b.color.mean.data()[e];
+  const double v0 = a.color.varianceOfMean.data()[e], v1 = b.color.varianceOfMean.data()[e];
+  if (!(n > 0)) {
+    const double mean = 0.5 * (m0 + m1);
+    const double variance = std::max(0.25 * (v0 + v1), 0.25 * (m0 - m1) * (m0 - m1));
+    return {mean, float(std::min(variance, double(kMaxFloat))), 0.0f};
+  }
+  const double mean = (n0 * m0 + n1 * m1) / n;
+  const double m2 = n0 * ((n0 > 1 ? v0 * (n0 - 1) : 0.0) + (m0 - mean) * (m0 - mean)) +
+                    n1 * ((n1 > 1 ? v1 * (n1 - 1) : 0.0) + (m1 - mean) * (m1 - mean));
+  const double variance = n >= 2 ? m2 / (n * (n - 1)) : 0.0;
+  return {mean, float(std::min(variance, double(kMaxFloat))), float(n)};
+}
+
 class PartGuard {
  public:
   PartGuard(const SubBuffer& part, const SubBuffer* other, const OutlierGuardOptions& options)
@@ -67,12 +94,48 @@ class PartGuard {
   size_t run(MeanVariance& out, std::vector<uint8_t>& changed) const {
     const int h = part_.height();
     std::vector<size_t> rowCounts(size_t(h), 0);
-    parallelRows(0, h, [&](int y) { rowCounts[size_t(y)] = guardRow(y, out, changed); });
+    std::vector<std::vector<Excess>> rowExcess(static_cast<size_t>(h));
+    parallelRows(0, h, [&](int y) {
+      rowCounts[size_t(y)] = guardRow(y, out, changed, rowExcess[size_t(y)]);
+    });
+    // In raster order, so that the sums do not depend on the thread count.
+    for (const std::vector<Excess>& excesses : rowExcess)
+      for (const Excess& excess : excesses) spread(excess, out, changed);
     return std::accumulate(rowCounts.begin(), rowCounts.end(), size_t(0));
   }
 
  private:
-  size_t guardRow(int y, MeanVariance& out, std::vector<uint8_t>& changed) const {
+  // What an outlier had above its replacement, to be spread over its neighbourhood.
+  struct Excess {
+    int x, y, c;
+    double amount;
+  };
+
+  // Adds amount × k(q) / Σ k to every pixel q of the (2 spreadRadius + 1)² window inside the
+  // image, the outlier's own included, with the Gaussian k(q) = exp(−|q − p|² / (2 (r/2)²)): the
+  // window keeps the outlier's energy, without the edges a box would draw.
+  void spread(const Excess& e, MeanVariance& out, std::vector<uint8_t>& changed) const {
+    const int w = part_.width(), h = part_.height(), r = o_.spreadRadius;
+    const int x0 = std::max(0, e.x - r), x1 = std::min(w - 1, e.x + r);
+    const int y0 = std::max(0, e.y - r), y1 = std::min(h - 1, e.y + r);
+    const double falloff = 2.0 / (double(r) * double(r));  // 1 / (2 σ²), σ = r / 2
+    auto kernel = [&](int x, int y) {
+      const double dx = x - e.x, dy = y - e.y;
+      return std::exp(-(dx * dx + dy * dy) * falloff);
+    };
+    double total = 0;
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) total += kernel(x, y);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) {
+        float& m = out.mean(x, y, e.c);
+        m = float(std::min(double(m) + e.amount * kernel(x, y) / total, double(kMaxFloat)));
+        changed[size_t(y) * size_t(w) + size_t(x)] = 1;
+      }
+  }
+
+  size_t guardRow(int y, MeanVariance& out, std::vector<uint8_t>& changed,
+                  std::vector<Excess>& excesses) const {
     const Image& mean = part_.color.mean;
     const Image& variance = part_.color.varianceOfMean;
     const int w = mean.width(), h = mean.height(), r = o_.radius;
@@ -120,21 +183,31 @@ class PartGuard {
         std::nth_element(spreads.data(), spreads.data() + count / 2, spreads.data() + count);
         noise = std::max(noise, kMadToSigma * spreads[size_t(count / 2)]);
 
-        double ceiling = std::max(level + o_.ceilingSigmas * noise, high);
-        if (other_) {
-          const float otherValue = other_->color.mean(x, y, c);
-          if (std::isfinite(otherValue))
-            ceiling = std::max(ceiling, double(o_.otherHalfRatio) * otherValue);
-        }
+        const double ceiling = std::max(level + o_.ceilingSigmas * noise, high);
         if (!(value > ceiling)) continue;
         const size_t pixel = size_t(y) * size_t(w) + size_t(x);
-        if (ownSamplesConfirm(value - level, variance(x, y, c), countAt(part_, pixel),
-                              o_.confirmSigmas))
+        // The evidence: the pixel's samples in this part, or in both halves when the other
+        // half has the pixel (a second, independent firefly in the other half does not make
+        // two halves that agree: their pooled samples still do not confirm the excess).
+        const bool pool = other_ && std::isfinite(other_->color.mean(x, y, c));
+        const PixelStats evidence =
+            pool ? mergedAt(part_, *other_, pixel, c)
+                 : PixelStats{value, variance(x, y, c), countAt(part_, pixel)};
+        if (samplesConfirm(evidence.mean - level, evidence.variance, evidence.count,
+                           o_.confirmSigmas))
           continue;
         const double replacement =
             withoutLargestSample(value, variance(x, y, c), countAt(part_, pixel), level, noise);
         const double clampedValue = std::clamp(replacement, std::min(0.0, level), ceiling);
         out.mean(x, y, c) = float(clampedValue);
+        // Peers: neighbours that deviate from L as much make the RMS deviation of the
+        // neighbourhood comparable to this excess. The outlier is then one of many samples of
+        // a heavy-tailed distribution present here (a caustic), whose energy is part of the
+        // image: it is spread over the window rather than dropped.
+        double squares = 0;
+        for (int i = 0; i < count; ++i) squares += (first[i] - level) * (first[i] - level);
+        if (value - level <= o_.peerSigmas * std::sqrt(squares / count))
+          excesses.push_back({x, y, c, value - clampedValue});
         const double excess = clampedValue - level;
         const double cap = std::max(noise * noise, excess * excess);
         const float v = variance(x, y, c);
@@ -151,29 +224,12 @@ class PartGuard {
   const OutlierGuardOptions& o_;
 };
 
-// The whole's colour at pixel i re-merged from the two halves (Chan et al.'s update, as in
-// merge()); equal weights when the halves record no sample counts.
+// The whole's colour at pixel i re-merged from the two halves.
 void remergeColor(const std::array<SubBuffer, 2>& halves, size_t i, SubBuffer& whole) {
-  const double n0 = std::max(0.0f, countAt(halves[0], i)),
-               n1 = std::max(0.0f, countAt(halves[1], i));
-  const double n = n0 + n1;
   for (int c = 0; c < 3; ++c) {
-    const size_t e = i * 3 + size_t(c);
-    const double m0 = halves[0].color.mean.data()[e], m1 = halves[1].color.mean.data()[e];
-    const double v0 = halves[0].color.varianceOfMean.data()[e];
-    const double v1 = halves[1].color.varianceOfMean.data()[e];
-    double mean, variance;
-    if (n > 0) {
-      mean = (n0 * m0 + n1 * m1) / n;
-      const double m2 = n0 * ((n0 > 1 ? v0 * (n0 - 1) : 0.0) + (m0 - mean) * (m0 - mean)) +
-                        n1 * ((n1 > 1 ? v1 * (n1 - 1) : 0.0) + (m1 - mean) * (m1 - mean));
-      variance = n >= 2 ? m2 / (n * (n - 1)) : 0.0;
-    } else {
-      mean = 0.5 * (m0 + m1);
-      variance = 0.25 * (v0 + v1);
-    }
-    whole.color.mean.data()[e] = float(mean);
-    whole.color.varianceOfMean.data()[e] = float(std::min(variance, 3.0e38));
+    const PixelStats merged = mergedAt(halves[0], halves[1], i, c);
+    whole.color.mean.data()[i * 3 + size_t(c)] = float(merged.mean);
+    whole.color.varianceOfMean.data()[i * 3 + size_t(c)] = merged.variance;
   }
 }
 

@@ -52,9 +52,9 @@ EnsembleSources sourcesFromHalves(const DenoiseInput& input) {
 
 EnsembleGuides guidesFromSources(const EnsembleSources& sources) {
   EnsembleGuides guides;
-  // The noisy colours as the members saw them: with the outlier guard's clamps. A firefly left
-  // in x^B would dominate every error estimate (y^A − x^B)² around it.
-  guides.color = guardOutliers(sources.full).input.whole.color.mean;
+  guides.color = sources.full.whole.color.mean;
+  // The halves the error estimate compares the members with, as the members saw them: with the
+  // outlier guard's clamps. A firefly left in x^B would dominate every (y^A − x^B)² around it.
   guides.colorA = guardOutliers(sources.a).input.whole.color.mean;
   guides.colorB = guardOutliers(sources.b).input.whole.color.mean;
   guides.albedo = sources.full.whole.albedo.mean;

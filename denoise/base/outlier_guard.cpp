@@ -157,7 +157,7 @@ class PartGuard {
         if (count < kMinNeighbours) continue;
         // Q = the value exceeded by `highRank` neighbours. value > Q exactly when at most
         // highRank neighbours reach it: most pixels stop here, before any sorting.
-        const int highRank = count / 6;
+        const int highRank = count / 12;
         if (count - below > highRank) continue;
         float* first = values.data();
         std::nth_element(first, first + highRank, first + count, std::greater<float>());
@@ -183,7 +183,8 @@ class PartGuard {
         std::nth_element(spreads.data(), spreads.data() + count / 2, spreads.data() + count);
         noise = std::max(noise, kMadToSigma * spreads[size_t(count / 2)]);
 
-        const double ceiling = std::max(level + o_.ceilingSigmas * noise, high);
+        const double ceiling =
+            std::max(level + o_.ceilingSigmas * noise, high > 0 ? o_.highFactor * high : high);
         if (!(value > ceiling)) continue;
         const size_t pixel = size_t(y) * size_t(w) + size_t(x);
         // The evidence: the pixel's samples in this part, or in both halves when the other

@@ -6,8 +6,10 @@
 // Per sub-buffer S of the input (its two halves when it has them, else the whole), per pixel p
 // and colour channel, with x = S's mean at p and, over the (2 radius + 1)² neighbours q ≠ p in S:
 //   L  = median of the means,  σ_N = max(median of √(variance of the mean), 1.4826 · MAD),
-//   Q  = the value exceeded by only a sixth of the neighbours (the 5th largest of 24),
-//   T  = max(L + ceilingSigmas · σ_N, Q).
+//   Q  = the value exceeded by only a twelfth of the neighbours (the 3rd largest of 24),
+//   T  = max(L + ceilingSigmas · σ_N, highFactor · Q)  (Q itself when Q ≤ 0).
+// (Q keeps sparse but ordinary samples — a dim region lit by a few paths, where L and σ_N are
+// 0 — from counting as outliers: a firefly stands far above even the brightest neighbours.)
 // x > T is an outlier unless the pixel's samples confirm the excess: pooled with the other half
 // at p when there is one (else S's own), n ≥ 2 samples whose mean m has
 // m − L > confirmSigmas · √(variance of the mean). A single sample V among n gives a mean V / n
@@ -34,6 +36,7 @@ namespace chorus {
 struct OutlierGuardOptions {
   int radius = 2;
   float ceilingSigmas = 8.0f;  // 0: the guard is off
+  float highFactor = 4.0f;
   float confirmSigmas = 2.5f;
   float peerSigmas = 6.0f;
   int spreadRadius = 6;

@@ -4,7 +4,7 @@
     python3 scenes/generate_scenes.py [OUTPUT_DIR]     # default: the folder of this script
 
 A development tool: the committed .gltf/.bin/.png files are what chorus uses; this script keeps
-their geometry reproducible and reviewable. Scenes (see README.md):
+their geometry reproducible and reviewable. Scenes (see scenes/README.md):
   cornell-box.gltf       the default scene: the classic Cornell room, one emissive quad light
   glass-and-metal.gltf   glass sphere (transmission + volume), smooth and rough metal spheres,
                          checker floor (embedded PNG), one small bright emissive light

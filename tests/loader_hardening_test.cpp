@@ -1,8 +1,8 @@
 // Issue 27, file inputs: every malformed or hostile file the fuzzing campaign found (and the
 // ones found while fixing them) fails with one chorus::Error line naming the file, through
 // the library and through the CLI (exit code 2), instead of crashing, hanging or exhausting
-// memory. The inputs live in tests/inputs/hardening (make_inputs.py writes them; README.md
-// lists the findings); FIFOs cannot be committed and are made here.
+// memory. The inputs live in tests/inputs/hardening (make_inputs.py writes them;
+// docs/hardening-inputs.md lists the findings); FIFOs cannot be committed and are made here.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <stb_image.h>
@@ -150,8 +150,9 @@ TEST(LoaderHardening, SceneLargerThanMemoryIsRefusedBeforeItsDataIsRead) {
   b.root()["accessors"][size_t(i)]["count"] = render::kMaxSceneVertices;
   b.addNode({{"mesh", b.addMesh({test::GltfBuilder::primitive(p, i, -1, -1, -1, 5)})}});
   b.writeGltf(dir / "huge.gltf");
-  expectOneLineError(errorOf([&] { render::loadGltf(dir / "huge.gltf"); }), dir / "huge.gltf",
-                     "loading 268435454 triangles and 268435456 vertices (instances included) needs");
+  expectOneLineError(
+      errorOf([&] { render::loadGltf(dir / "huge.gltf"); }), dir / "huge.gltf",
+      "loading 268435454 triangles and 268435456 vertices (instances included) needs");
 }
 
 // While alive, keeps opening the write end of `fifo` (non-blocking), so that a reader blocked

@@ -2,7 +2,7 @@
 """Writes the regression inputs of tests/loader_hardening_test.cpp (issue 27) into this directory.
 
 Each file is the smallest input that reproduced one finding: a crash, a hang, an
-out-of-bounds access or an uncaught exception in chorus's loaders. README.md lists them with
+out-of-bounds access or an uncaught exception in chorus's loaders. docs/hardening-inputs.md lists them with
 the finding and the expected error. Run from anywhere: python3 make_inputs.py
 
 With --memory-scenes DIR it instead writes the two large scenes that docs/hardening-inputs.md

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/regular_file.h"
 
 namespace chorus {
 namespace fs = std::filesystem;
@@ -59,6 +60,7 @@ int removeTemporaryFiles(const fs::path& dir, bool recursive) {
 }
 
 std::string readFileBytes(const fs::path& file) {
+  requireRegularFile(file);
   std::ifstream in(file, std::ios::binary);
   if (!in) throw fileError(file, "cannot open");
   std::ostringstream bytes;

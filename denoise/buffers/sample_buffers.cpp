@@ -3,10 +3,15 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
 namespace chorus {
+namespace {
+constexpr double kMaxFloat = std::numeric_limits<float>::max();
+}  // namespace
 
 int channelCount(Quantity q) {
   return (q == Quantity::Depth || q == Quantity::Visibility) ? 1 : 3;
@@ -167,8 +172,8 @@ SubBuffer merge(const std::vector<const SubBuffer*>& parts) {
           }
         }
       }
-      for (size_t k = 0; variance && k < count;
-           ++k) {  // M2_k = V_k n_k (n_k − 1), V_k its variance of the mean
+      // M2_k = V_k n_k (n_k − 1), V_k its variance of the mean.
+      for (size_t k = 0; variance && k < count; ++k) {
         const float* partMean = parts[k]->get(q).mean.data() + offset;
         const float* partVariance = parts[k]->get(q).varianceOfMean.data() + offset;
         for (size_t i = 0; i < size; ++i) {
@@ -188,7 +193,8 @@ SubBuffer merge(const std::vector<const SubBuffer*>& parts) {
       for (size_t i = 0; i < size; ++i)
         for (size_t c = 0; c < channels; ++c) {
           const size_t e = i * channels + c;
-          outVariance[e] = float(m2[e] * varianceScale[i]);
+          // Clamped: the square of a finite radiance above ~1.8e19 is not a finite float.
+          outVariance[e] = float(std::min(m2[e] * varianceScale[i], kMaxFloat));
         }
     }
   });

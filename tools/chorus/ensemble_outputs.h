@@ -5,9 +5,11 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
+#include "common/image/exr_io.h"
 #include "denoise/pipeline/ensemble.h"
 
 namespace chorus::cli {
@@ -28,12 +30,20 @@ nlohmann::ordered_json metricsJson(const Image& image, const Image& reference);
 // The options of a combination, for stats.json.
 nlohmann::ordered_json combineOptionsJson(const CombineOptions& options);
 
-// DIR/<name>.exr (layers: RGB = the blend, A, B, mseEstimate) and DIR/<name>.png.
+// Writes the layers after repairForOutput (common/image/output_values.h: no NaN/Inf, and no
+// negative radiance except in the layers `isSigned` names), with one warning line on stderr
+// counting what was replaced. Returns the layers as written.
+std::vector<ExrLayer> writeRepairedExr(
+    const std::filesystem::path& path, std::vector<ExrLayer> layers,
+    const std::function<bool(const std::string&)>& isSigned = {});
+
+// DIR/<name>.exr (layers: RGB = the blend, A, B, mseEstimate) and DIR/<name>.png, through
+// writeRepairedExr.
 void writeCombined(const std::filesystem::path& dir, const std::string& name,
                    const CombineResult& result);
 
 // The weight maps as DIR/<file>: one layer per base, and noisyFallback (1 where the blend is the
-// noisy value) when the combiner has one.
+// noisy value) when the combiner has one; through writeRepairedExr (weights may be negative).
 void writeWeights(const std::filesystem::path& dir, const std::string& file,
                   const CombineResult& result, const std::vector<BaseOutputs>& bases);
 

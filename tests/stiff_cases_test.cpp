@@ -238,15 +238,16 @@ TEST(StiffCases, MergeKeepsHugeVariancesFinite) {
   }
 }
 
-TEST(StiffCases, RenderAtTheLargestFloatStaysFinite) {
-  // A background of 3e38 (squares overflow; the variance of the mean saturates at FLT_MAX):
-  // render.exr's full-buffer variance is finite, and so is everything the default members and
-  // the ensemble write.
+TEST(StiffCases, RenderAtTheLargestAcceptedRadianceStaysFinite) {
+  // The brightest environment the flags accept (--background 1e6 times --env-intensity 1e6;
+  // larger values are refused, docs/hardening-cli.md): radiance 1e12, far outside the guard's
+  // 2^-20 … 2^20 band. render.exr's full-buffer variance is finite, and so is everything the
+  // default members and the ensemble write. MergeKeepsHugeVariancesFinite covers 3e38.
   const test::TempDir dir("chorus_stiff_render");
-  const auto r =
-      test::runChorus({"render", (test::sourceDir() / "scenes/cornell-box.gltf").string(),
-                       "--width", "12", "--height", "12", "--spp", "8", "--background", "3e38",
-                       "--keep", "members,weights", "--out", dir.path().string(), "--quiet"});
+  const auto r = test::runChorus(
+      {"render", (test::sourceDir() / "scenes/cornell-box.gltf").string(), "--width", "12",
+       "--height", "12", "--spp", "8", "--background", "1e6", "--env-intensity", "1e6", "--keep",
+       "members,weights", "--out", dir.path().string(), "--quiet"});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const std::filesystem::path renderExr = dir / "render.exr";
   const SampleBuffers buffers = sampleBuffersFromLayers(readExr(renderExr), renderExr);
@@ -254,7 +255,7 @@ TEST(StiffCases, RenderAtTheLargestFloatStaysFinite) {
   EXPECT_EQ(firstBadValue(full.color.varianceOfMean), "");
   float largest = 0;
   for (float v : full.color.mean.values()) largest = std::max(largest, v);
-  EXPECT_GT(largest, 1e38f);  // the background is seen
+  EXPECT_GT(largest, 1e11f);  // the background is seen
   for (const char* file : {"denoised.exr", "nfor.exr", "rdfc.exr", "atrous.exr", "weights.exr"})
     for (const ExrLayer& layer : readExr(dir / file))
       if (layer.name != "mseEstimate") EXPECT_EQ(firstBadValue(layer.image), "") << file;

@@ -149,8 +149,12 @@ TEST(LeaveOutCli, RenderWritesMemberAndWeightFilesOnlyWithKeep) {
     const json outputs = readJson(out / "stats.json")["outputs"];
     EXPECT_EQ(sorted(outputs["written"].get<std::vector<std::string>>()), sorted(expected));
     EXPECT_EQ(keysOf(outputs["left_out"]), sorted(leftOut)) << c.keep;
-    if (!c.members) EXPECT_EQ(outputs["left_out"]["atrous.exr"], "--keep members");
-    if (!c.weights) EXPECT_EQ(outputs["left_out"]["weights.exr"], "--keep weights");
+    if (!c.members) {
+      EXPECT_EQ(outputs["left_out"]["atrous.exr"], "--keep members");
+    }
+    if (!c.weights) {
+      EXPECT_EQ(outputs["left_out"]["weights.exr"], "--keep weights");
+    }
   }
   // The denoised image does not depend on what is kept.
   EXPECT_TRUE(sameBits(readExrLayer(dir / "keep-" / "denoised.exr"),
@@ -207,6 +211,41 @@ TEST(LeaveOutCli, DenoiseWritesMemberAndWeightFilesOnlyWithKeep) {
   EXPECT_TRUE(outputs["left_out"].empty());
   EXPECT_TRUE(sameBits(readExrLayer(dir / "plain" / "ensemble.exr"),
                        readExrLayer(dir / "kept" / "ensemble.exr")));
+}
+
+// `chorus info SCENE --methods LIST` says what a render for LIST records, leaves out and writes:
+// à-trous reads feature means only and needs no halves of its own input (2 sub-buffers); NFOR
+// reads every plane and needs halves of each of its three inputs (4).
+TEST(LeaveOutCli, InfoListsWhatARenderForTheMembersRecordsAndLeavesOut) {
+  auto r = runChorus({"info", cornellBox(), "--methods", "atrous"});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  for (const char* line :
+       {"denoising   atrous: 2 sub-buffer(s)\n", "  records   colour, albedo, normal, depth\n",
+        "  left out  albedo variance, normal variance, depth variance, "
+        "visibility, visibility variance\n",
+        "  writes    render.exr, color.png, denoised.exr, denoised.png, "
+        "stats.json\n",
+        "  only with weights.exr (--keep weights), atrous.exr (--keep members)"
+        "\n",
+        "needs       textures: none (no texture lookups)\n"})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
+
+  r = runChorus({"info", cornellBox()});  // the default members
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("denoising   nfor,rdfc,atrous (default): 4 sub-buffer(s)\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("  left out  nothing\n"), std::string::npos) << r.out;
+
+  r = runChorus({"info", (test::sourceDir() / "scenes" / "punctual-lights.gltf").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("textures: 1 material(s) look textures up"), std::string::npos) << r.out;
+
+  r = runChorus({"info", cornellBox(), "--methods", "atrous,nosuch"});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("nosuch"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
 }
 
 }  // namespace

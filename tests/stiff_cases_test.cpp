@@ -257,8 +257,11 @@ TEST(StiffCases, RenderAtTheLargestAcceptedRadianceStaysFinite) {
   for (float v : full.color.mean.values()) largest = std::max(largest, v);
   EXPECT_GT(largest, 1e11f);  // the background is seen
   for (const char* file : {"denoised.exr", "nfor.exr", "rdfc.exr", "atrous.exr", "weights.exr"})
-    for (const ExrLayer& layer : readExr(dir / file))
-      if (layer.name != "mseEstimate") EXPECT_EQ(firstBadValue(layer.image), "") << file;
+    for (const ExrLayer& layer : readExr(dir / file)) {
+      if (layer.name != "mseEstimate") {
+        EXPECT_EQ(firstBadValue(layer.image), "") << file;
+      }
+    }
 }
 
 TEST(StiffCases, DenoiseRepairsExternalMembers) {

@@ -33,6 +33,15 @@ constexpr int kTileSize = 32;  // tile side; tiles are always kTileSize wide (se
 constexpr int kLanes = 16;
 static_assert(kTileSize % kLanes == 0);
 using Lanes = float __attribute__((vector_size(kLanes * sizeof(float))));
+// The Gram sums are formed in double: on near-collinear columns (a smooth surface's normals
+// are almost linear in dx, dy) the part of a column the others do not explain is far below
+// float rounding of the sums, and a float Gram either loses it or (with a coarse pivot
+// tolerance) has to drop the column — which Tungsten's QR on √W X keeps. The products of
+// float inputs w · x_a are exact in double.
+using SumLanes = double __attribute__((vector_size(kLanes * sizeof(double))));
+inline SumLanes wide(Lanes v) {
+  return __builtin_convertvector(v, SumLanes);
+}
 
 inline Lanes loadLanes(const float* p) {
   Lanes v;
@@ -112,22 +121,23 @@ constexpr int sumIndex(int total, int a, int b) {
 // every centre of the group has one are skipped — neighbours across a strong edge, outside the
 // image. accumulateSums marks them (skip[offsetIndex(δ)]) for accumulatePredictions.
 //
-// sums (see kMaxSums) = Σ_δ w_δ · x_a · x_b for every centre of the group. Each window row is
-// summed on its own first and then added (two-level summation: shorter float sums). Column 2
+// sums (see kMaxSums) = Σ_δ w_δ · x_a · x_b for every centre of the group, in double. Each
+// window row is summed on its own first and then added (two-level summation). Column 2
 // is dy, constant along a window row, so its sums are dy times the row's sums with column 0
 // (Σ w dy x_b = dy Σ w x_b), formed once per row instead of at every offset. The weights are
 // also copied to `groupWeights` (w_δ at offsetIndex(δ) · kLanes) for the predictions: the
 // table's planes are far apart, and this way it is read only once.
 template <int kD, int kC>
-[[gnu::always_inline]] inline void accumulateSumsOf(const Group& g, Lanes* sums,
+[[gnu::always_inline]] inline void accumulateSumsOf(const Group& g, SumLanes* sums,
                                                     float* groupWeights, uint8_t* skip) {
   const int d = kD ? kD : g.d, C = kD ? kC : g.channels, total = d + C;
   const int count = d * (d + 1) / 2 + d * C;
-  Lanes fp[kMaxGramSize], x[kMaxColumns], rowSums[kMaxSums];
+  Lanes fp[kMaxGramSize], x[kMaxColumns];
+  SumLanes xd[kMaxColumns], rowSums[kMaxSums];
   centreFeatures(g, d, fp);
-  for (int e = 0; e < count; ++e) sums[e] = Lanes{};
+  for (int e = 0; e < count; ++e) sums[e] = SumLanes{};
   for (int dy = -g.r; dy <= g.r; ++dy) {
-    for (int e = 0; e < count; ++e) rowSums[e] = Lanes{};
+    for (int e = 0; e < count; ++e) rowSums[e] = SumLanes{};
     for (int dx = -g.r; dx <= g.r; ++dx) {
       // Each offset's weights are in another plane of the table, a cache line no hardware
       // prefetcher predicts: ask for the one a few offsets ahead.
@@ -138,25 +148,29 @@ template <int kD, int kC>
       *skip = allZero(w);
       if (*skip++) continue;
       designRow(g, d, C, fp, dx, dy, x);
+      const SumLanes wd = wide(w);
       if constexpr (kD > 0) {
+#pragma GCC unroll 32
+        for (int a = 0; a < kD + kC; ++a) xd[a] = wide(x[a]);
 #pragma GCC unroll 32
         for (int a = 0; a < kD; ++a) {
           if (a == 2) continue;
-          const Lanes wa = w * x[a];
+          const SumLanes wa = wd * xd[a];
 #pragma GCC unroll 32
           for (int b = a; b < kD + kC; ++b)
-            if (b != 2) rowSums[sumIndex(kD + kC, a, b)] += wa * x[b];
+            if (b != 2) rowSums[sumIndex(kD + kC, a, b)] += wa * xd[b];
         }
       } else {
+        for (int a = 0; a < total; ++a) xd[a] = wide(x[a]);
         for (int a = 0; a < d; ++a) {
           if (a == 2) continue;
-          const Lanes wa = w * x[a];
+          const SumLanes wa = wd * xd[a];
           for (int b = a; b < total; ++b)
-            if (b != 2) rowSums[sumIndex(total, a, b)] += wa * x[b];
+            if (b != 2) rowSums[sumIndex(total, a, b)] += wa * xd[b];
         }
       }
     }
-    const Lanes rowDy = splat(float(dy));
+    const SumLanes rowDy = SumLanes{} + double(dy);
     rowSums[sumIndex(total, 0, 2)] = rowDy * rowSums[sumIndex(total, 0, 0)];
     rowSums[sumIndex(total, 1, 2)] = rowDy * rowSums[sumIndex(total, 0, 1)];
     for (int b = 2; b < total; ++b)
@@ -165,7 +179,7 @@ template <int kD, int kC>
   }
 }
 
-CHORUS_SIMD_CLONES void accumulateSums(const Group& g, Lanes* sums, float* groupWeights,
+CHORUS_SIMD_CLONES void accumulateSums(const Group& g, SumLanes* sums, float* groupWeights,
                                        uint8_t* skip) {
   if (g.d == kNforColumns && g.channels == kNforChannels)
     accumulateSumsOf<kNforColumns, kNforChannels>(g, sums, groupWeights, skip);
@@ -223,7 +237,7 @@ struct TileResult {
 struct ThreadState {
   NlMeansScratch scratch;
   std::vector<float> table;  // weights [offset][tile pixel], tile rows kTileSize wide
-  Lanes sums[kMaxSums];
+  SumLanes sums[kMaxSums];
   std::vector<float> groupWeights;  // w_δ of one group, offset after offset
   std::vector<uint8_t> skip;        // per offset: every weight of the group is 0
 };
@@ -316,11 +330,11 @@ class Regression {
   }
 
   // β of every live lane from its sums (rank-revealing, in double); β = 0 for the others.
-  void solveLanes(const Lanes* sums, int live, Lanes* beta) const {
+  void solveLanes(const SumLanes* sums, int live, Lanes* beta) const {
     for (int e = 0; e < d_ * channels_; ++e) beta[e] = Lanes{};
     for (int lane = 0; lane < live; ++lane) {
       double gram[kMaxGramSize * kMaxGramSize], rhs[kMaxGramSize * kMaxGramRhs];
-      const Lanes* s = sums;
+      const SumLanes* s = sums;
       for (int a = 0; a < d_; ++a) {
         for (int b = a; b < d_; ++b) gram[a * d_ + b] = (*s++)[lane];
         for (int c = 0; c < channels_; ++c) rhs[a * channels_ + c] = (*s++)[lane];

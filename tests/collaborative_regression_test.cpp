@@ -168,6 +168,22 @@ TEST(CollaborativeRegression, RankDeficientFeaturesDoNotBlowUp) {
   expectRelativeNear(out, s.image, 1e-4);
 }
 
+TEST(CollaborativeRegression, PoweredWeightsMatchTheSmallerBandwidth) {
+  // Data that no first-order model fits (noise), so the output depends on every weight: the
+  // regression with weights w^4 (k = 1) must equal one with weights computed for k = 0.5, and
+  // power 1 the plain regression.
+  Scene s = affineScene(40, 36, 4, 40);
+  s.image = test::randomImage(40, 36, 3, 41, 0.0f, 1.0f);
+  const int powers[] = {4, 1};
+  const std::vector<Image> out =
+      collaborativeRegressions(s.image, s.features, regressionWeights(s, 5, 1.0f), powers);
+  ASSERT_EQ(out.size(), 2u);
+  expectRelativeNear(
+      out[0], collaborativeRegression(s.image, s.features, regressionWeights(s, 5, 0.5f)), 1e-3);
+  expectRelativeNear(
+      out[1], collaborativeRegression(s.image, s.features, regressionWeights(s, 5, 1.0f)), 1e-6);
+}
+
 TEST(CollaborativeRegression, ZeroVarianceGuideKeepsEveryPixel) {
   // Zero variance and distinct guide values: every neighbour weight is 0, each window holds
   // only its centre, and the regression returns the input.

@@ -1,10 +1,14 @@
-// bench_nfor: speed and quality of NFOR and dual-buffer NL-means on the Tungsten peer data
-// (../shared/peers/tungsten-nfor).
+// bench_nfor: speed and quality of NFOR (with dual-buffer NL-means and RDFC next to it) on the
+// Tungsten peer data (../shared/peers/tungsten-nfor).
 //   speed:   seconds per megapixel on --threads threads (default 2), on one case's input
-//            buffers tiled to --size × --size (default 1024 × 1024);
-//   quality: relMSE against the reference for the six cases, next to Tungsten's own NFOR
-//            output, and how close our NFOR is to Tungsten's;
-//   --outputs DIR: our NFOR outputs (the speed case and the six quality cases) are compared
+//            buffers tiled to --size × --size (default 1024 × 1024): wall and CPU (user + sys of
+//            the process, i.e. summed over threads), and NFOR's speed-up per CPU-second over
+//            Tungsten's NFOR (--tungsten-cpu CPU-s/Mpx on one thread, default 470);
+//   quality: relMSE against the reference for the nine cases, next to Tungsten's own NFOR
+//            output, and how close our NFOR is to Tungsten's; the same split into the pixels
+//            around highlights (within 4 px of a reference value > 0.6, the peers README's
+//            definition) and the rest;
+//   --outputs DIR: our NFOR outputs (the speed case and the nine quality cases) are compared
 //            with DIR/<name>.exr where those exist (max |difference|, relMSE) and written there
 //            where not — run once before a change and once after to see what it changed.
 #include <tbb/global_control.h>
@@ -17,14 +21,17 @@
 #include <ctime>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "common/error.h"
 #include "common/image/exr_io.h"
 #include "common/memory_reuse.h"
 #include "denoise/base/nfor/nfor.h"
 #include "denoise/base/nlm/dual_buffer_nlm.h"
+#include "denoise/base/rdfc/rdfc.h"
 #include "denoise/buffers/tungsten_dir.h"
 #include "denoise/metrics/metrics.h"
+#include "tests/support/highlight_region.h"
 
 namespace chorus {
 namespace {
@@ -106,11 +113,15 @@ void compareOrKeep(const std::filesystem::path& dir, const std::string& name, co
 }
 
 int run(int argc, char** argv) {
-  CLI::App app("Speed (s/Mpx) and quality (relMSE) of nfor and nlm on the Tungsten peer data");
+  CLI::App app(
+      "Speed (s/Mpx) of nfor, nlm and rdfc and quality (relMSE) of nfor and nlm on the "
+      "Tungsten peer data");
   std::string shared = "../shared";
   int threads = 2, size = 1024;
   std::string speedCase = "room/spp4";
-  bool skipSpeed = false, skipQuality = false;
+  bool skipSpeed = false, skipQuality = false, skipNlm = false;
+  double tungstenCpu = 470;
+  bool nforOnly = false;
   std::string outputs;
   app.add_option("--shared", shared, "the shared data directory");
   app.add_option("--threads", threads, "TBB threads");
@@ -118,6 +129,10 @@ int run(int argc, char** argv) {
   app.add_option("--case", speedCase, "the peer case tiled for the speed measurement");
   app.add_flag("--skip-speed", skipSpeed);
   app.add_flag("--skip-quality", skipQuality);
+  app.add_flag("--nfor-only", nforOnly, "speed: time NFOR only (for profiling)");
+  app.add_flag("--skip-nlm", skipNlm, "quality: run NFOR only (the nlm column reads 0)");
+  app.add_option("--tungsten-cpu", tungstenCpu,
+                 "Tungsten's NFOR in CPU-s/Mpx (one thread; the peers' timings: 470-500)");
   app.add_option("--outputs", outputs, "compare our NFOR outputs with those kept here (or keep)");
   CLI11_PARSE(app, argc, argv);
   const std::filesystem::path root = std::filesystem::path(shared) / "peers/tungsten-nfor";
@@ -129,36 +144,54 @@ int run(int argc, char** argv) {
     const double mpx = double(size) * size / 1e6;
     Image output;
     const Timing nfor = timed([&] { output = NforDenoiser().run(input); });
-    const Timing nlm = timed([&] { DualBufferNlMeans().run(input); });
+    Timing nlm, rdfc;
+    if (!nforOnly) {
+      nlm = timed([&] { DualBufferNlMeans().run(input); });
+      rdfc = timed([&] { Rdfc().run(input); });
+    }
     // cpu / threads is what the wall clock would be on otherwise idle cores with perfect
     // scaling: a load-independent figure next to the wall clock.
     std::printf("speed: %s tiled to %dx%d, %d threads\n", speedCase.c_str(), size, size, threads);
     std::printf("  %-6s %9s %9s %14s\n", "", "wall s/Mpx", "cpu s/Mpx", "cpu/threads");
-    for (const auto& [name, t] : {std::pair{"nfor", nfor}, std::pair{"nlm", nlm}})
+    for (const auto& [name, t] :
+         {std::pair{"nfor", nfor}, std::pair{"nlm", nlm}, std::pair{"rdfc", rdfc}})
       std::printf("  %-6s %9.2f %9.2f %14.2f\n", name, t.wall / mpx, t.cpu / mpx,
                   t.cpu / mpx / threads);
+    std::printf("  nfor per CPU-second: %.1fx Tungsten's NFOR (%.0f CPU-s/Mpx)\n",
+                tungstenCpu / (nfor.cpu / mpx), tungstenCpu);
     compareOrKeep(outputs, "speed", output);
   }
   if (!skipQuality) {
     std::printf(
         "quality (relMSE against reference.exr; frac = relMSE(ours, nfor.exr) / "
         "relMSE(noisy, nfor.exr))\n");
-    std::printf("  %-7s %-6s %10s %10s %10s %7s %8s %10s %8s\n", "scene", "spp", "noisy",
-                "tungsten", "nfor", "ratio", "frac", "nlm", "nfor s");
-    for (const char* scene : {"room", "glossy"}) {
+    std::printf(
+        "  highlight columns: relMSE share of the pixels around highlights and the ratio "
+        "ours / Tungsten there and elsewhere\n");
+    std::printf("  %-10s %-6s %10s %10s %10s %7s %8s %10s %8s %8s %8s %8s\n", "scene", "spp",
+                "noisy", "tungsten", "nfor", "ratio", "frac", "nlm", "nfor s", "hl share",
+                "hl ratio", "rest");
+    for (const char* scene : {"room", "glossy", "highlights"}) {
       const Image reference = readExrLayer(root / scene / "reference.exr");
+      const std::vector<bool> mask = test::highlightMask(reference);
       for (const char* spp : {"spp4", "spp16", "spp64"}) {
         const auto dir = root / scene / spp;
         const DenoiseInput input = readTungstenDirectory(dir);
         const Image tungsten = readExrLayer(dir / "nfor.exr");
         Image ours;
         const double time = seconds([&] { ours = NforDenoiser().run(input); });
-        const Image nlm = DualBufferNlMeans().run(input);
+        const Image nlm = skipNlm ? tungsten : DualBufferNlMeans().run(input);
         const double oursRef = relMse(ours, reference), tungRef = relMse(tungsten, reference);
-        std::printf("  %-7s %-6s %10.6f %10.6f %10.6f %7.4f %8.4f %10.6f %8.2f\n", scene, spp,
-                    relMse(input.whole.color.mean, reference), tungRef, oursRef, oursRef / tungRef,
-                    relMse(ours, tungsten) / relMse(input.whole.color.mean, tungsten),
-                    relMse(nlm, reference), time);
+        const double tungHl = test::relMsePart(tungsten, reference, mask, true);
+        const double oursHl = test::relMsePart(ours, reference, mask, true);
+        const double tungRest = test::relMsePart(tungsten, reference, mask, false);
+        const double oursRest = test::relMsePart(ours, reference, mask, false);
+        std::printf(
+            "  %-10s %-6s %10.6f %10.6f %10.6f %7.4f %8.4f %10.6f %8.2f %8.3f %8.4f %8.4f\n", scene,
+            spp, relMse(input.whole.color.mean, reference), tungRef, oursRef, oursRef / tungRef,
+            relMse(ours, tungsten) / relMse(input.whole.color.mean, tungsten),
+            skipNlm ? 0.0 : relMse(nlm, reference), time, tungHl / tungRef, oursHl / tungHl,
+            oursRest / tungRest);
         compareOrKeep(outputs, std::string(scene) + "_" + spp, ours);
       }
     }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -33,6 +34,15 @@ constexpr int kTileSize = 32;  // tile side; tiles are always kTileSize wide (se
 constexpr int kLanes = 16;
 static_assert(kTileSize % kLanes == 0);
 using Lanes = float __attribute__((vector_size(kLanes * sizeof(float))));
+// The Gram sums are formed in double: on near-collinear columns (a smooth surface's normals
+// are almost linear in dx, dy) the part of a column the others do not explain is far below
+// float rounding of the sums, and a float Gram either loses it or (with a coarse pivot
+// tolerance) has to drop the column — which Tungsten's QR on √W X keeps. The products of
+// float inputs w · x_a are exact in double.
+using SumLanes = double __attribute__((vector_size(kLanes * sizeof(double))));
+inline SumLanes wide(Lanes v) {
+  return __builtin_convertvector(v, SumLanes);
+}
 
 inline Lanes loadLanes(const float* p) {
   Lanes v;
@@ -112,22 +122,23 @@ constexpr int sumIndex(int total, int a, int b) {
 // every centre of the group has one are skipped — neighbours across a strong edge, outside the
 // image. accumulateSums marks them (skip[offsetIndex(δ)]) for accumulatePredictions.
 //
-// sums (see kMaxSums) = Σ_δ w_δ · x_a · x_b for every centre of the group. Each window row is
-// summed on its own first and then added (two-level summation: shorter float sums). Column 2
+// sums (see kMaxSums) = Σ_δ w_δ · x_a · x_b for every centre of the group, in double. Each
+// window row is summed on its own first and then added (two-level summation). Column 2
 // is dy, constant along a window row, so its sums are dy times the row's sums with column 0
 // (Σ w dy x_b = dy Σ w x_b), formed once per row instead of at every offset. The weights are
 // also copied to `groupWeights` (w_δ at offsetIndex(δ) · kLanes) for the predictions: the
 // table's planes are far apart, and this way it is read only once.
 template <int kD, int kC>
-[[gnu::always_inline]] inline void accumulateSumsOf(const Group& g, Lanes* sums,
+[[gnu::always_inline]] inline void accumulateSumsOf(const Group& g, SumLanes* sums,
                                                     float* groupWeights, uint8_t* skip) {
   const int d = kD ? kD : g.d, C = kD ? kC : g.channels, total = d + C;
   const int count = d * (d + 1) / 2 + d * C;
-  Lanes fp[kMaxGramSize], x[kMaxColumns], rowSums[kMaxSums];
+  Lanes fp[kMaxGramSize], x[kMaxColumns];
+  SumLanes xd[kMaxColumns], rowSums[kMaxSums];
   centreFeatures(g, d, fp);
-  for (int e = 0; e < count; ++e) sums[e] = Lanes{};
+  for (int e = 0; e < count; ++e) sums[e] = SumLanes{};
   for (int dy = -g.r; dy <= g.r; ++dy) {
-    for (int e = 0; e < count; ++e) rowSums[e] = Lanes{};
+    for (int e = 0; e < count; ++e) rowSums[e] = SumLanes{};
     for (int dx = -g.r; dx <= g.r; ++dx) {
       // Each offset's weights are in another plane of the table, a cache line no hardware
       // prefetcher predicts: ask for the one a few offsets ahead.
@@ -138,25 +149,29 @@ template <int kD, int kC>
       *skip = allZero(w);
       if (*skip++) continue;
       designRow(g, d, C, fp, dx, dy, x);
+      const SumLanes wd = wide(w);
       if constexpr (kD > 0) {
+#pragma GCC unroll 32
+        for (int a = 0; a < kD + kC; ++a) xd[a] = wide(x[a]);
 #pragma GCC unroll 32
         for (int a = 0; a < kD; ++a) {
           if (a == 2) continue;
-          const Lanes wa = w * x[a];
+          const SumLanes wa = wd * xd[a];
 #pragma GCC unroll 32
           for (int b = a; b < kD + kC; ++b)
-            if (b != 2) rowSums[sumIndex(kD + kC, a, b)] += wa * x[b];
+            if (b != 2) rowSums[sumIndex(kD + kC, a, b)] += wa * xd[b];
         }
       } else {
+        for (int a = 0; a < total; ++a) xd[a] = wide(x[a]);
         for (int a = 0; a < d; ++a) {
           if (a == 2) continue;
-          const Lanes wa = w * x[a];
+          const SumLanes wa = wd * xd[a];
           for (int b = a; b < total; ++b)
-            if (b != 2) rowSums[sumIndex(total, a, b)] += wa * x[b];
+            if (b != 2) rowSums[sumIndex(total, a, b)] += wa * xd[b];
         }
       }
     }
-    const Lanes rowDy = splat(float(dy));
+    const SumLanes rowDy = SumLanes{} + double(dy);
     rowSums[sumIndex(total, 0, 2)] = rowDy * rowSums[sumIndex(total, 0, 0)];
     rowSums[sumIndex(total, 1, 2)] = rowDy * rowSums[sumIndex(total, 0, 1)];
     for (int b = 2; b < total; ++b)
@@ -165,7 +180,7 @@ template <int kD, int kC>
   }
 }
 
-CHORUS_SIMD_CLONES void accumulateSums(const Group& g, Lanes* sums, float* groupWeights,
+CHORUS_SIMD_CLONES void accumulateSums(const Group& g, SumLanes* sums, float* groupWeights,
                                        uint8_t* skip) {
   if (g.d == kNforColumns && g.channels == kNforChannels)
     accumulateSumsOf<kNforColumns, kNforChannels>(g, sums, groupWeights, skip);
@@ -222,8 +237,9 @@ struct TileResult {
 
 struct ThreadState {
   NlMeansScratch scratch;
-  std::vector<float> table;  // weights [offset][tile pixel], tile rows kTileSize wide
-  Lanes sums[kMaxSums];
+  std::vector<float> table;    // weights [offset][tile pixel], tile rows kTileSize wide
+  std::vector<float> powered;  // the table's weights raised to a power
+  SumLanes sums[kMaxSums];
   std::vector<float> groupWeights;  // w_δ of one group, offset after offset
   std::vector<uint8_t> skip;        // per offset: every weight of the group is 0
 };
@@ -231,8 +247,9 @@ struct ThreadState {
 class Regression {
  public:
   Regression(const Image& image, const Image& features, const NlMeansWeights& weights,
-             const GramTolerances& tol)
+             std::span<const int> powers, const GramTolerances& tol)
       : weights_(weights),
+        powers_(powers.begin(), powers.end()),
         tol_(tol),
         width_(image.width()),
         height_(image.height()),
@@ -253,16 +270,24 @@ class Regression {
     for (int c = 0; c < channels_; ++c) fu_.set(m_ + c, image, c);
   }
 
-  Image run() {
+  // One output per power.
+  std::vector<Image> run() {
     std::vector<PixelRect> tiles;
     for (int y = 0; y < height_; y += kTileSize)
       for (int x = 0; x < width_; x += kTileSize)
         tiles.push_back({x, y, x + kTileSize, std::min(height_, y + kTileSize)});
-    std::vector<TileResult> results(tiles.size());
+    std::vector<std::vector<TileResult>> results(powers_.size(),
+                                                 std::vector<TileResult>(tiles.size()));
     tbb::enumerable_thread_specific<ThreadState> states;
-    tbb::parallel_for(size_t(0), tiles.size(),
-                      [&](size_t t) { regressTile(tiles[t], states.local(), results[t]); });
-    return gather(tiles, results);
+    tbb::parallel_for(size_t(0), tiles.size(), [&](size_t t) {
+      ThreadState& st = states.local();
+      fillWeightTable(tiles[t], st);
+      for (size_t i = 0; i < powers_.size(); ++i)
+        regressTile(tiles[t], st, weightsToPower(tiles[t], st, powers_[i]), results[i][t]);
+    });
+    std::vector<Image> out;
+    for (const auto& r : results) out.push_back(gather(tiles, r));
+    return out;
   }
 
  private:
@@ -288,8 +313,33 @@ class Regression {
     });
   }
 
-  void regressTile(const PixelRect& tile, ThreadState& st, TileResult& out) const {
-    fillWeightTable(tile, st);
+  // The table's weights raised to `power` (the table itself for 1): w^p is the weight of the
+  // bandwidth k / √p, whose distances are p times larger (up to ε and the distance clamp, which
+  // only decide where weights are 0 anyway). Like computed weights, they are 0 where exp would
+  // underflow, and the centre weight keeps the floor of CenterWeight::Computed.
+  const float* weightsToPower(const PixelRect& tile, ThreadState& st, int power) const {
+    if (power == 1) return st.table.data();
+    st.powered.resize(st.table.size());
+    const float* src = st.table.data();
+    float* dst = st.powered.data();
+    for (size_t i = 0; i < st.table.size(); ++i) {
+      float w = src[i];
+      for (int e = 1; e < power; ++e) w *= src[i];
+      dst[i] = w < kSmallestWeight ? 0.0f : w;
+    }
+    if (weights_.params().center == CenterWeight::Computed) {
+      float* center = dst + size_t(offsetIndex(0, 0)) * planeStride();
+      for (int y = 0; y < tile.height(); ++y)
+        for (int x = 0; x < std::min(kTileSize, width_ - tile.x0); ++x) {
+          float& w = center[y * kTileSize + x];
+          w = std::max(w, weights_.params().minCenterWeight);
+        }
+    }
+    return dst;
+  }
+
+  void regressTile(const PixelRect& tile, ThreadState& st, const float* table,
+                   TileResult& out) const {
     out.extent = tile.grown(r_);
     const size_t accWidth = size_t(out.extent.width()), accPlane = size_t(out.extent.area());
     out.acc.assign(accPlane * size_t(channels_ + 1), 0.0f);
@@ -297,15 +347,14 @@ class Regression {
     st.skip.resize(size_t(side_ * side_));
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x0 = tile.x0; x0 < std::min(tile.x1, width_); x0 += kLanes) {
-        const Group g{
-            .x0 = x0,
-            .y = y,
-            .r = r_,
-            .d = d_,
-            .channels = channels_,
-            .weights = st.table.data() + size_t(y - tile.y0) * kTileSize + size_t(x0 - tile.x0),
-            .weightStride = planeStride(),
-            .fu = &fu_};
+        const Group g{.x0 = x0,
+                      .y = y,
+                      .r = r_,
+                      .d = d_,
+                      .channels = channels_,
+                      .weights = table + size_t(y - tile.y0) * kTileSize + size_t(x0 - tile.x0),
+                      .weightStride = planeStride(),
+                      .fu = &fu_};
         accumulateSums(g, st.sums, st.groupWeights.data(), st.skip.data());
         Lanes beta[kMaxGramSize * kMaxGramRhs];
         solveLanes(st.sums, std::min(kLanes, width_ - x0), beta);
@@ -316,11 +365,11 @@ class Regression {
   }
 
   // β of every live lane from its sums (rank-revealing, in double); β = 0 for the others.
-  void solveLanes(const Lanes* sums, int live, Lanes* beta) const {
+  void solveLanes(const SumLanes* sums, int live, Lanes* beta) const {
     for (int e = 0; e < d_ * channels_; ++e) beta[e] = Lanes{};
     for (int lane = 0; lane < live; ++lane) {
       double gram[kMaxGramSize * kMaxGramSize], rhs[kMaxGramSize * kMaxGramRhs];
-      const Lanes* s = sums;
+      const SumLanes* s = sums;
       for (int a = 0; a < d_; ++a) {
         for (int b = a; b < d_; ++b) gram[a * d_ + b] = (*s++)[lane];
         for (int c = 0; c < channels_; ++c) rhs[a * channels_ + c] = (*s++)[lane];
@@ -365,7 +414,11 @@ class Regression {
     return result;
   }
 
+  // exp(−41): fast_exp gives 0 below about this.
+  static constexpr float kSmallestWeight = 1.6e-18f;
+
   const NlMeansWeights& weights_;
+  std::vector<int> powers_;
   GramTolerances tol_;
   int width_, height_, r_, side_, channels_, m_, d_;
   BorderedPlanes fu_;  // the features (non-finite → 0), then the data, with a zero border
@@ -373,8 +426,10 @@ class Regression {
 
 }  // namespace
 
-Image collaborativeRegression(const Image& image, const Image& features,
-                              const NlMeansWeights& weights, const GramTolerances& tolerances) {
+namespace {
+
+void checkRegressionInputs(const Image& image, const Image& features,
+                           const NlMeansWeights& weights) {
   if (weights.weightChannels() != 1)
     throw std::invalid_argument("collaborativeRegression: needs scalar weights");
   if (!image.sameSize(features) || image.width() != weights.width() ||
@@ -382,7 +437,26 @@ Image collaborativeRegression(const Image& image, const Image& features,
     throw std::invalid_argument("collaborativeRegression: image/feature/weight sizes differ");
   if (image.channels() > kMaxGramRhs || 3 + features.channels() > kMaxGramSize)
     throw std::invalid_argument("collaborativeRegression: too many channels or features");
-  return Regression(image, features, weights, tolerances).run();
+}
+
+}  // namespace
+
+Image collaborativeRegression(const Image& image, const Image& features,
+                              const NlMeansWeights& weights, const GramTolerances& tolerances) {
+  checkRegressionInputs(image, features, weights);
+  const int one = 1;
+  return Regression(image, features, weights, std::span<const int>(&one, 1), tolerances).run()[0];
+}
+
+std::vector<Image> collaborativeRegressions(const Image& image, const Image& features,
+                                            const NlMeansWeights& weights,
+                                            std::span<const int> powers,
+                                            const GramTolerances& tolerances) {
+  for (int p : powers)
+    if (p < 1 || p > kMaxWeightPower)
+      throw std::invalid_argument("collaborativeRegressions: power out of range");
+  checkRegressionInputs(image, features, weights);
+  return Regression(image, features, weights, powers, tolerances).run();
 }
 
 }  // namespace chorus

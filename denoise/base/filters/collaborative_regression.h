@@ -10,6 +10,9 @@
 // order, so the result does not depend on the thread count. Within a tile, sixteen consecutive
 // centres of a row are regressed together, one per vector lane (AVX-512, AVX2 and baseline
 // builds give the same bits).
+#include <span>
+#include <vector>
+
 #include "common/image/image.h"
 #include "denoise/base/filters/gram_solver.h"
 #include "denoise/base/filters/nlmeans_weights.h"
@@ -21,5 +24,17 @@ namespace chorus {
 // window radius r is the regression window. Throws std::invalid_argument on mismatches.
 Image collaborativeRegression(const Image& image, const Image& features,
                               const NlMeansWeights& weights, const GramTolerances& tolerances = {});
+
+inline constexpr int kMaxWeightPower = 16;
+
+// The regressions with weights w^p for every p of `powers` (1 ≤ p ≤ kMaxWeightPower), from one
+// evaluation of `weights`: NL-means distances scale with 1 / k², so w^p is the weight of the
+// bandwidth k / √p (NFOR's k = 0.5 from k = 1: p = 4) — exactly, except where ε or the distance
+// clamp matter, i.e. where the weights are (numerically) 0 anyway. Underflowing powers are 0, the
+// centre keeps the minCenterWeight floor. One output per power.
+std::vector<Image> collaborativeRegressions(const Image& image, const Image& features,
+                                            const NlMeansWeights& weights,
+                                            std::span<const int> powers,
+                                            const GramTolerances& tolerances = {});
 
 }  // namespace chorus

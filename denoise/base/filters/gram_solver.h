@@ -16,8 +16,11 @@ namespace chorus {
 inline constexpr int kMaxGramSize = 24;  // d ≤ 24 columns (3 + up to 21 features)
 inline constexpr int kMaxGramRhs = 4;    // C ≤ 4 right-hand sides
 
+// The default pivot tolerance suits Gram sums formed in double: a column is dropped when less
+// than ~3e-6 of its norm is independent of the others, close to where Eigen's float
+// column-pivoted QR (threshold d · ε_float relative to the largest pivot) stops in Tungsten.
 struct GramTolerances {
-  double relativePivotTolerance = 1e-5;
+  double relativePivotTolerance = 1e-11;
   double absoluteDiagonalTolerance = 1e-13;
 };
 

@@ -1,6 +1,7 @@
 #include "denoise/base/nfor/nfor.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -141,13 +142,10 @@ class NforRun {
 
     // Regression passes (§5.2): colour of one half, weights from the other half's colour,
     // regressed on the other half's filtered features.
-    Image y1[2], y2[2], mse[2];
-    const float ks[2] = {p_.k1, p_.k2};
-    for (int i = 0; i < 2; ++i) {
-      y1[i] = regress(c1, f2Filtered, c2, sigma2, p_.regressionF, ks[i], p_.regressionR);
-      y2[i] = regress(c2, f1Filtered, c1, sigma2, p_.regressionF, ks[i], p_.regressionR);
-      mse[i] = mseEstimate(c1, c2, y1[i], y2[i], sigma2);
-    }
+    const std::array<Image, 2> y1 = regressBothBandwidths(c1, f2Filtered, c2, sigma2);
+    const std::array<Image, 2> y2 = regressBothBandwidths(c2, f1Filtered, c1, sigma2);
+    Image mse[2];
+    for (int i = 0; i < 2; ++i) mse[i] = mseEstimate(c1, c2, y1[i], y2[i], sigma2);
 
     // Bandwidth selection (§5.3): smoothed MSE, per-channel binary map, smoothed map.
     const NlMeansWeights smoothing(perChannelTerm(c, sigma2, p_.mseF, p_.mseK, 1.0f),
@@ -198,21 +196,42 @@ class NforRun {
   // Tungsten's regression weights: one weight per pixel (min over the colour channels), the
   // variance scale always 2 (a half's variance is twice the whole's) — also in the final pass,
   // where it is kept for fidelity.
+  NlMeansTerm regressionTerm(const Image& guide, const Image& variance, int f, float k) const {
+    return {.guide = &guide,
+            .variance = &variance,
+            .f = f,
+            .k = k,
+            .alpha = 1.0f,
+            .s = 2.0f,
+            .epsilon = p_.epsilon,
+            .distanceClamp = p_.distanceClamp,
+            .channels = ChannelWeights::MinOverChannels};
+  }
+
   Image regress(const Image& image, const Image& features, const Image& guide,
                 const Image& variance, int f, float k, int r) const {
-    const NlMeansTerm term{.guide = &guide,
-                           .variance = &variance,
-                           .f = f,
-                           .k = k,
-                           .alpha = 1.0f,
-                           .s = 2.0f,
-                           .epsilon = p_.epsilon,
-                           .distanceClamp = p_.distanceClamp,
-                           .channels = ChannelWeights::MinOverChannels};
-    const NlMeansWeights weights(term, window(r));
+    const NlMeansWeights weights(regressionTerm(guide, variance, f, k), window(r));
     Image out = collaborativeRegression(image, features, weights);
     fallBackWhereImplausible(out, image, weights, r);
     return out;
+  }
+
+  // The first-pass regressions for k1 and k2. When (k2 / k1)² is a whole number p (Tungsten's
+  // 0.5 and 1: p = 4), k1's weights are k2's to the power p, so the weights are computed once.
+  std::array<Image, 2> regressBothBandwidths(const Image& image, const Image& features,
+                                             const Image& guide, const Image& variance) const {
+    const int f = p_.regressionF, r = p_.regressionR;
+    const double ratio = double(p_.k2) / double(p_.k1), power = std::round(ratio * ratio);
+    if (power < 1 || power > kMaxWeightPower || std::abs(ratio * ratio - power) > 1e-6)
+      return {regress(image, features, guide, variance, f, p_.k1, r),
+              regress(image, features, guide, variance, f, p_.k2, r)};
+    const NlMeansWeights weights2(regressionTerm(guide, variance, f, p_.k2), window(r));
+    const int powers[2] = {int(power), 1};
+    std::vector<Image> out = collaborativeRegressions(image, features, weights2, powers);
+    fallBackWhereImplausible(out[1], image, weights2, r);
+    const NlMeansWeights weights1(regressionTerm(guide, variance, f, p_.k1), window(r));
+    fallBackWhereImplausible(out[0], image, weights1, r);
+    return {std::move(out[0]), std::move(out[1])};
   }
 
   // Where the regression's prediction leaves the range of the data in the pixel's window by

@@ -5,19 +5,25 @@
 #   tools/setup.sh build  install missing packages and build only
 #   tools/setup.sh bench  also install the renderer benchmark's peer (embree-tools), build,
 #                         run build/bench/bench_render (about 3 minutes after the build)
-# Environment: BUILD_DIR (default build), JOBS (default: number of cores), CI=true adds -Werror.
+#   tools/setup.sh sanitize  build the unit tests, chorus and the fuzzer with AddressSanitizer
+#                         and UBSan in build-asan/ (-O1, no benchmarks) and run the unit tests,
+#                         which include the fuzz regression inputs (docs/fuzzing.md)
+# Environment: BUILD_DIR (default build; build-asan for sanitize), JOBS (default: number of
+# cores), CI=true adds -Werror (not to the sanitizer build: the instrumentation makes GCC warn
+# inside its own intrinsics headers).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 mode=${1:-demo}
 case "$mode" in
-  demo | test | build | bench) ;;
+  demo | test | build | bench | sanitize) ;;
   *)
-    echo "usage: tools/setup.sh [demo|test|build|bench]" >&2
+    echo "usage: tools/setup.sh [demo|test|build|bench|sanitize]" >&2
     exit 2
     ;;
 esac
 build_dir=${BUILD_DIR:-build}
+[ "$mode" = sanitize ] && build_dir=${BUILD_DIR:-build-asan}
 jobs=${JOBS:-$(nproc)}
 
 packages=(g++ cmake make pkg-config libembree-dev libtinygltf-dev libopenexr-dev libtbb-dev
@@ -39,10 +45,22 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-werror=OFF
-[ "${CI:-}" = "true" ] && werror=ON
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCHORUS_WERROR=$werror > /dev/null
-cmake --build "$build_dir" -j "$jobs"
+if [ "$mode" = sanitize ]; then
+  cmake -S . -B "$build_dir" -DCHORUS_ASAN=ON -DCMAKE_BUILD_TYPE=Sanitize \
+    -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -DNDEBUG" > /dev/null
+  # Only what the unit tests run: chorus, the fuzzer and every test but the slow ones.
+  targets=(chorus fuzz_inputs)
+  for t in tests/*_test.cpp; do
+    name=$(basename "$t" .cpp)
+    [[ $name == *_slow_test ]] || targets+=("$name")
+  done
+  cmake --build "$build_dir" -j "$jobs" --target "${targets[@]}"
+else
+  werror=OFF
+  [ "${CI:-}" = "true" ] && werror=ON
+  cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCHORUS_WERROR=$werror > /dev/null
+  cmake --build "$build_dir" -j "$jobs"
+fi
 
 case "$mode" in
   build) ;;
@@ -51,6 +69,10 @@ case "$mode" in
     ;;
   bench)
     "$build_dir"/bench/bench_render
+    ;;
+  sanitize)
+    # `-L unit`: the slow tests are not built here (CTest lists them as *_NOT_BUILT, unlabelled).
+    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -L unit
     ;;
   demo)
     out=out/cornell-box

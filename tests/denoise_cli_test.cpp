@@ -8,8 +8,11 @@
 #include <nlohmann/json.hpp>
 
 #include "common/image/exr_io.h"
+#include "common/image/output_values.h"
+#include "denoise/base/nfor/nfor.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/buffers_exr.h"
+#include "denoise/buffers/tungsten_dir.h"
 #include "denoise/ensemble/combiners.h"
 #include "denoise/ensemble/outputs_directory.h"
 #include "denoise/metrics/metrics.h"
@@ -116,8 +119,10 @@ TEST(DenoiseCli, OptionsReachTheLibrary) {
   const std::vector<const BaseOutputs*> bases = {&f.prepared.bases[0], &f.prepared.bases[2]};
   const CombineResult direct = combine(f.prepared.guides, bases, o);
   const Image written = readExrLayer(out / "ensemble.exr");
+  Image expected = direct.image;
+  repairForOutput(expected);  // as the writers do: the noisy fallback has negative values here
   EXPECT_TRUE(
-      std::equal(written.values().begin(), written.values().end(), direct.image.values().begin()));
+      std::equal(written.values().begin(), written.values().end(), expected.values().begin()));
   EXPECT_EQ(readExrLayer(out / "weights.exr", "box1").channels(), 3);  // per channel
   const json stats = readJson(out / "stats.json");
   EXPECT_EQ(stats["options"]["noisy_fallback"], 1.5);
@@ -139,12 +144,14 @@ TEST(DenoiseCli, CleanFailures) {
                 "oidn: missing method folder");
   expectOneLine({in, "--methods", "box1", "--combine", "best", "--out", out.string()},
                 "unknown combiner 'best'");
+  expectOneLine({in, "--methods", "box1,nlm", "--combine", "none,average", "--out", out.string()},
+                "--combine none runs each method alone");
   expectOneLine({in, "--methods", "box1", "--combine", "oracle", "--out", out.string()},
                 "needs --reference");
   expectOneLine({in, "--methods", "box1", "--mse", "diagonal", "--out", out.string()},
                 "unknown --mse");
   expectOneLine({in, "--methods", "box1", "--noisy-fallback", "0.5", "--out", out.string()},
-                "--noisy-fallback must be 0 (off) or at least 1");
+                "--noisy-fallback: must be 0 (off) or a number in [1, 1e+06]");
   expectOneLine({(f.dir / "nothing").string(), "--methods", "box1", "--out", out.string()},
                 "no such file or directory");
   // A method file of another size.
@@ -158,12 +165,28 @@ TEST(DenoiseCli, CleanFailures) {
   EXPECT_FALSE(fs::exists(out / "stats.json"));
 }
 
+// The synthetic scene and noise of the render.exr and Tungsten fixtures.
+const synthetic::Scene& fixtureScene() {
+  static const synthetic::Scene scene = synthetic::makeScene(synthetic::SceneKind::Shadows, 36, 28);
+  return scene;
+}
+constexpr synthetic::NoiseModel kFixtureNoise{1.0f, 4, 0.0f};
+
+SampleBuffers fixtureBuffers(int splits) {
+  return synthetic::renderBuffers(fixtureScene(), kFixtureNoise, splits, 4);
+}
+
 // A render.exr written from K sub-buffers of a synthetic scene.
 fs::path writeRender(const TempDir& dir, int splits) {
-  const synthetic::Scene scene = synthetic::makeScene(synthetic::SceneKind::Shadows, 36, 28);
-  const SampleBuffers buffers = synthetic::renderBuffers(scene, {1.0f, 4, 0.0f}, splits, 4);
   const fs::path path = dir / ("render" + std::to_string(splits) + ".exr");
-  writeExr(path, sampleBuffersToLayers(buffers));
+  writeExr(path, sampleBuffersToLayers(fixtureBuffers(splits)));
+  return path;
+}
+
+// The expected value of the fixtures' pixels, as a reference file.
+fs::path writeTruth(const TempDir& dir) {
+  const fs::path path = dir / "truth.exr";
+  writeExr(path, synthetic::expectedValue(fixtureScene(), kFixtureNoise));
   return path;
 }
 
@@ -201,6 +224,160 @@ TEST(DenoiseCli, RenderExrWithRegisteredDenoisers) {
       runChorus({"denoise", render.string(), "--methods", "nosuchdenoiser", "--out", out.string()});
   EXPECT_EQ(bad.exitCode, 2);
   EXPECT_NE(bad.err.find("unknown denoiser 'nosuchdenoiser'"), std::string::npos) << bad.err;
+}
+
+std::vector<std::string> filesIn(const fs::path& dir) {
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(dir)) files.push_back(entry.path().filename());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// relMSE of the image in `file` against the truth, recomputed from the written file.
+double relMseOfFile(const fs::path& file, const fs::path& truth) {
+  return relMse(readExrLayer(file), readRgbExr(truth));
+}
+
+// One method (no --combine) or --combine none: each member alone on the full buffer, no half
+// runs, no ensemble; a K = 1 render feeds every member that needs no halves.
+TEST(DenoiseCli, MembersAloneOnAOneSubBufferRender) {
+  TempDir dir("chorus_denoise_alone");
+  const fs::path render = writeRender(dir, 1), truth = writeTruth(dir);
+  const fs::path one = dir / "one", two = dir / "two";
+  auto r = runChorus({"denoise", render.string(), "--methods", "atrous", "--reference",
+                      truth.string(), "--out", one.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(filesIn(one), (std::vector<std::string>{"atrous.exr", "atrous.png", "stats.json"}));
+  EXPECT_EQ(layerNames(one / "atrous.exr"), std::vector<std::string>{""});
+  // What the member computes on the full buffer, and nothing else ran.
+  const Image expected = createDenoiser("atrous")->run(fixtureBuffers(1).input(BufferPart::Full));
+  const Image written = readExrLayer(one / "atrous.exr");
+  ASSERT_TRUE(written.sameSize(expected));
+  EXPECT_TRUE(
+      std::equal(written.values().begin(), written.values().end(), expected.values().begin()));
+  const json stats = readJson(one / "stats.json");
+  EXPECT_EQ(stats["input_kind"], "render.exr");
+  EXPECT_EQ(stats["combine"], "none");
+  EXPECT_TRUE(stats["seconds"].contains("atrous/full"));
+  EXPECT_FALSE(stats["seconds"].contains("atrous/A"));
+  const json& m = stats["metrics"];
+  EXPECT_NEAR(m["atrous"]["relmse"].get<double>(), relMseOfFile(one / "atrous.exr", truth), 1e-9);
+  EXPECT_NEAR(m["noisy"]["relmse"].get<double>(),
+              relMse(fixtureBuffers(1).sub(0).color.mean, readRgbExr(truth)), 1e-9);
+  EXPECT_LT(m["atrous"]["relmse"].get<double>(), 0.5 * m["noisy"]["relmse"].get<double>());
+  for (const char* key : {"dssim", "psnr"}) EXPECT_TRUE(m["atrous"].contains(key)) << key;
+
+  // Several methods, each alone: the same à-trous output beside the others'.
+  r = runChorus({"denoise", render.string(), "--methods", "atrous,jnlm,sbf,bilateral", "--combine",
+                 "none", "--out", two.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  for (const char* name : {"atrous", "jnlm", "sbf", "bilateral"})
+    EXPECT_TRUE(fs::is_regular_file(two / (std::string(name) + ".png"))) << name;
+  EXPECT_FALSE(fs::exists(two / "weights.exr"));
+  const Image again = readExrLayer(two / "atrous.exr");
+  EXPECT_TRUE(std::equal(again.values().begin(), again.values().end(), written.values().begin()));
+
+  // A member that needs halves: one line naming the file, the member and the fix; nothing
+  // written.
+  const fs::path bad = dir / "bad";
+  r = runChorus({"denoise", render.string(), "--methods", "atrous,nfor", "--combine", "none",
+                 "--out", bad.string()});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(lineCount(r.err), 1) << r.err;
+  for (const char* part : {"render1.exr: base denoiser 'nfor' needs two independent halves",
+                           "render without --splits 1"})
+    EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(bad));
+}
+
+// NFOR, RDFC and dual-buffer NL-means alone on a K = 2 render (the full buffer's two halves);
+// the ensemble needs K = 4 for them and says how to run them instead.
+TEST(DenoiseCli, HalvesMembersAloneOnATwoSubBufferRender) {
+  TempDir dir("chorus_denoise_alone");
+  const fs::path render = writeRender(dir, 2), truth = writeTruth(dir), out = dir / "out";
+  auto r = runChorus({"denoise", render.string(), "--methods", "nfor,rdfc,nlm", "--combine", "none",
+                      "--reference", truth.string(), "--out", out.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const json m = readJson(out / "stats.json")["metrics"];
+  for (const char* name : {"nfor", "rdfc", "nlm"}) {
+    const double relmse = m[name]["relmse"].get<double>();
+    EXPECT_NEAR(relmse, relMseOfFile(out / (std::string(name) + ".exr"), truth), 1e-9) << name;
+    EXPECT_LT(relmse, 0.5 * m["noisy"]["relmse"].get<double>()) << name;
+  }
+  r = runChorus({"denoise", render.string(), "--methods", "nfor,atrous", "--out",
+                 (dir / "ensemble").string()});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(lineCount(r.err), 1) << r.err;
+  for (const char* part :
+       {"render2.exr: base denoiser 'nfor' needs two independent halves of its own input",
+        "render with --splits 4, or run it alone with --combine none"})
+    EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
+}
+
+// A Tungsten buffer directory (T.exr, TA.exr, TB.exr, TVariance.exr per buffer) from the two
+// sub-buffers of a synthetic render.
+fs::path writeTungstenDirectory(const TempDir& dir) {
+  const SampleBuffers buffers = fixtureBuffers(2);
+  const SubBuffer full = buffers.part(BufferPart::Full);
+  const fs::path path = dir / "tungsten";
+  fs::create_directories(path);
+  for (Quantity q : kAllQuantities) {
+    const std::string name(quantityName(q));
+    writeExr(path / (name + ".exr"), full.get(q).mean);
+    writeExr(path / (name + "A.exr"), buffers.sub(0).get(q).mean);
+    writeExr(path / (name + "B.exr"), buffers.sub(1).get(q).mean);
+    writeExr(path / (name + "Variance.exr"), full.get(q).varianceOfMean);
+  }
+  return path;
+}
+
+TEST(DenoiseCli, NforAloneOnATungstenDirectory) {
+  TempDir dir("chorus_denoise_tungsten");
+  const fs::path input = writeTungstenDirectory(dir), truth = writeTruth(dir), out = dir / "out";
+  auto r = runChorus({"denoise", input.string(), "--methods", "nfor", "--reference", truth.string(),
+                      "--out", out.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(filesIn(out), (std::vector<std::string>{"nfor.exr", "nfor.png", "stats.json"}));
+  const Image expected = NforDenoiser().run(readTungstenDirectory(input));
+  const Image written = readExrLayer(out / "nfor.exr");
+  ASSERT_TRUE(written.sameSize(expected));
+  EXPECT_TRUE(
+      std::equal(written.values().begin(), written.values().end(), expected.values().begin()));
+  const json stats = readJson(out / "stats.json");
+  EXPECT_EQ(stats["input_kind"], "tungsten directory");
+  EXPECT_EQ(stats["combine"], "none");
+  const json& m = stats["metrics"];
+  EXPECT_NEAR(m["nfor"]["relmse"].get<double>(), relMseOfFile(out / "nfor.exr", truth), 1e-9);
+  EXPECT_LT(m["nfor"]["relmse"].get<double>(), 0.5 * m["noisy"]["relmse"].get<double>());
+
+  // In the ensemble NFOR would need halves of each half; members that need none blend.
+  r = runChorus(
+      {"denoise", input.string(), "--methods", "nfor,atrous", "--out", (dir / "bad").string()});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(lineCount(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("run it alone on the full buffer with --combine none"), std::string::npos)
+      << r.err;
+  r = runChorus({"denoise", input.string(), "--methods", "atrous,jnlm", "--out",
+                 (dir / "ensemble").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(dir / "ensemble" / "ensemble.exr"));
+}
+
+// An outputs directory alone: each method's full-buffer output as it is, with its metrics.
+TEST(DenoiseCli, OutputsDirectoryAlone) {
+  OutputsFixture f;
+  const fs::path out = f.dir / "out";
+  const auto r = runChorus({"denoise", f.input.string(), "--methods", "box1,nlm", "--combine",
+                            "none", "--reference", f.reference.string(), "--out", out.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(filesIn(out),
+            (std::vector<std::string>{"box1.exr", "box1.png", "nlm.exr", "nlm.png", "stats.json"}));
+  const Image box1 = readExrLayer(out / "box1.exr");
+  const Image& given = f.prepared.bases[0].full;
+  EXPECT_TRUE(std::equal(box1.values().begin(), box1.values().end(), given.values().begin()));
+  const json m = readJson(out / "stats.json")["metrics"];
+  EXPECT_NEAR(m["nlm"]["relmse"].get<double>(), relMse(f.prepared.bases[2].full, f.prepared.truth),
+              1e-9);
 }
 
 }  // namespace

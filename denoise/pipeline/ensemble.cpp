@@ -18,16 +18,30 @@ std::vector<EnsembleMember> membersFromSpecs(std::span<const std::string> specs)
   return members;
 }
 
-void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members) {
+namespace {
+
+// Members with distinct labels (their outputs' file and layer names), at least one.
+void checkLabels(std::span<const EnsembleMember> members) {
   if (members.empty()) throw Error("no base denoisers given");
+  std::set<std::string> labels;
+  for (const EnsembleMember& member : members)
+    if (!labels.insert(member.label).second)
+      throw Error("base denoiser '" + member.label + "' is listed twice");
+}
+
+bool needsHalves(const EnsembleMember& member) {
+  return member.denoiser->requirements().halves;
+}
+
+}  // namespace
+
+void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members) {
+  checkLabels(members);
   if (members.size() > size_t(kMaxDenoisers))
     throw Error("at most " + std::to_string(kMaxDenoisers) + " base denoisers, got " +
                 std::to_string(members.size()));
-  std::set<std::string> labels;
   for (const EnsembleMember& member : members) {
-    if (!labels.insert(member.label).second)
-      throw Error("base denoiser '" + member.label + "' is listed twice");
-    if (!member.denoiser->requirements().halves) continue;
+    if (!needsHalves(member)) continue;
     const char* missing = !sources.a.halves      ? "half A"
                           : !sources.b.halves    ? "half B"
                           : !sources.full.halves ? "the full buffer"
@@ -40,9 +54,40 @@ void checkMembersCanRun(const EnsembleSources& sources, std::span<const Ensemble
   }
 }
 
+void checkMembersCanRunAlone(const DenoiseInput& input, std::span<const EnsembleMember> members) {
+  checkLabels(members);
+  for (const EnsembleMember& member : members)
+    if (needsHalves(member) && !input.halves)
+      throw Error("base denoiser '" + member.label +
+                  "' needs two independent halves of its input, and this input has none");
+}
+
+std::vector<Image> runMembersAlone(const DenoiseInput& input,
+                                   std::span<const EnsembleMember> members,
+                                   std::vector<StageTime>* times) {
+  checkMembersCanRunAlone(input, members);
+  const Stopwatch all;
+  std::vector<Image> outputs(members.size());
+  std::vector<double> seconds(members.size());
+  tbb::task_group group;
+  for (size_t m = 0; m < members.size(); ++m)
+    group.run([&, m] {
+      const Stopwatch run;
+      outputs[m] = members[m].denoiser->run(input);
+      seconds[m] = run.seconds();
+    });
+  group.wait();
+  if (times) {
+    for (size_t m = 0; m < members.size(); ++m)
+      times->push_back({members[m].label + "/full", seconds[m]});
+    times->push_back({"members", all.seconds()});
+  }
+  return outputs;
+}
+
 int splitsNeeded(std::span<const EnsembleMember> members) {
   for (const EnsembleMember& member : members)
-    if (member.denoiser->requirements().halves) return 4;
+    if (needsHalves(member)) return 4;
   return 2;
 }
 

@@ -2,7 +2,8 @@
 // The ensemble runner: runs the chosen base denoisers on half A, half B and the full buffer (all
 // 3N runs in parallel as TBB tasks), then combines their outputs (combiners.h) and reports the
 // time of every stage. For sweeps that reuse base outputs across combinations, call
-// runBaseDenoisers() once and combine() per combination instead.
+// runBaseDenoisers() once and combine() per combination instead. runMembersAlone() runs members
+// on one input only, without the ensemble (`chorus denoise --combine none`).
 #include <memory>
 #include <span>
 #include <string>
@@ -38,6 +39,17 @@ int splitsNeeded(std::span<const EnsembleMember> members);
 // Whether some member needs or reads the halves of its input (else sourcesFromBuffers can leave
 // the full input's halves out: two copies of the render less).
 bool readsHalves(std::span<const EnsembleMember> members);
+
+// Throws chorus::Error (one line) when a member cannot run on `input` alone: one that needs two
+// independent halves of its input while `input` has none (a K = 1 render).
+void checkMembersCanRunAlone(const DenoiseInput& input, std::span<const EnsembleMember> members);
+
+// Every member on `input` only (no runs on halves, no combination), in parallel; the outputs in
+// member order. Appends "<label>/full" (the time of each run) and "members" (wall time of all of
+// them) to `times`.
+std::vector<Image> runMembersAlone(const DenoiseInput& input,
+                                   std::span<const EnsembleMember> members,
+                                   std::vector<StageTime>* times = nullptr);
 
 // Every member on sources.a, .b and .full, in parallel. Appends "<label>/A", "<label>/B",
 // "<label>/full" (the time of each run) and "bases" (wall time of all of them) to `times`.

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -34,19 +35,40 @@ std::string slurp(const fs::path& path) {
 }  // namespace
 
 ProcessResult runChorus(const std::vector<std::string>& args) {
+  return runProgram(CHORUS_BINARY, args);
+}
+
+ProcessResult runProgram(const fs::path& program, const std::vector<std::string>& args,
+                         const std::vector<std::pair<std::string, std::string>>& environment) {
   TempDir capture("chorus_capture");
   const fs::path outPath = capture / "stdout", errPath = capture / "stderr";
+  // Everything the child needs is built before fork: only exec-safe calls after it.
+  std::vector<std::string> words = {program.string()};
+  words.insert(words.end(), args.begin(), args.end());
+  std::vector<std::string> variables;
+  for (char** v = environ; *v; ++v) {
+    const std::string variable = *v;
+    const std::string name = variable.substr(0, variable.find('='));
+    bool replaced = false;
+    for (const auto& e : environment) replaced = replaced || e.first == name;
+    if (!replaced) variables.push_back(variable);
+  }
+  for (const auto& [name, value] : environment) variables.push_back(name + "=" + value);
+  const auto pointers = [](std::vector<std::string>& strings) {
+    std::vector<char*> p;
+    for (std::string& s : strings) p.push_back(s.data());
+    p.push_back(nullptr);
+    return p;
+  };
+  const std::vector<char*> argv = pointers(words), envp = pointers(variables);
+  // Else the child's freopen writes what the test printed so far a second time.
+  std::fflush(stdout);
+  std::fflush(stderr);
   const pid_t pid = ::fork();
   if (pid == 0) {
-    std::vector<char*> argv;
-    std::string binary = CHORUS_BINARY;
-    argv.push_back(binary.data());
-    std::vector<std::string> copies = args;
-    for (std::string& a : copies) argv.push_back(a.data());
-    argv.push_back(nullptr);
     if (!std::freopen(outPath.c_str(), "w", stdout) || !std::freopen(errPath.c_str(), "w", stderr))
       std::_Exit(127);
-    ::execv(binary.c_str(), argv.data());
+    ::execve(argv[0], argv.data(), envp.data());
     std::_Exit(127);
   }
   int status = 0;

@@ -7,6 +7,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/image/image.h"
@@ -33,6 +34,10 @@ struct ProcessResult {
 };
 // Runs the chorus binary built with the tests with these arguments, capturing both streams.
 ProcessResult runChorus(const std::vector<std::string>& args);
+// Runs `program` (a path) with these arguments and these variables added to the environment,
+// capturing both streams.
+ProcessResult runProgram(const std::filesystem::path& program, const std::vector<std::string>& args,
+                         const std::vector<std::pair<std::string, std::string>>& environment = {});
 
 // The project's source directory (for scenes/).
 std::filesystem::path sourceDir();

@@ -1,13 +1,15 @@
-// chorus denoise INPUT --methods a,b,... --out DIR: base denoisers plus an ensemble combiner
-// (denoise/ensemble/) on
-//   (a) a render.exr from `chorus render` (built-in methods from the registry),
-//   (b) a directory in the ensemble paper's layout with the outputs of external denoisers
-//       (color.exr, colorA.exr, colorB.exr, albedo.exr, normal.exr, <m>/<m>{,A,B}.exr),
-//   (c) a Tungsten buffer directory (built-in methods; only halves A/B, no quarters).
-// Writes DIR/<combiner>.exr/.png, DIR/weights.exr, DIR/<method>.exr and DIR/stats.json.
+// chorus denoise INPUT --methods a,b,... --out DIR: base denoisers, alone or blended per pixel by
+// a combiner (denoise/ensemble/), on
+//   (a) a render.exr from `chorus render` (built-in members; its K sub-buffers),
+//   (b) a Tungsten buffer directory (built-in members; the full buffer and its halves A/B),
+//   (c) a directory in the ensemble paper's layout with the outputs of external denoisers
+//       (color.exr, colorA.exr, colorB.exr, albedo.exr, normal.exr, <m>/<m>{,A,B}.exr).
+// --combine none (the default for a single method) runs each member alone on the full buffer:
+// DIR/<method>.exr/.png and DIR/stats.json. Any other combiner runs every member on half A,
+// half B and the full buffer and blends them: DIR/<combiner>.exr/.png, DIR/weights.exr,
+// DIR/<method>.exr and DIR/stats.json. docs/cli.md: which input can feed which member.
 #include <nlohmann/json.hpp>
 
-#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -17,17 +19,19 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/image/exr_io.h"
+#include "common/image/finite_pixels.h"
 #include "common/image/png_io.h"
+#include "common/owned_directory.h"
 #include "common/stopwatch.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/buffers_exr.h"
 #include "denoise/buffers/tungsten_dir.h"
 #include "denoise/ensemble/outputs_directory.h"
-#include "denoise/metrics/metrics.h"
 #include "denoise/pipeline/ensemble.h"
 #include "tools/chorus/command.h"
 #include "tools/chorus/ensemble_flags.h"
 #include "tools/chorus/ensemble_outputs.h"
+#include "tools/chorus/flag_checks.h"
 
 namespace chorus::cli {
 namespace {
@@ -37,104 +41,217 @@ using Json = nlohmann::ordered_json;
 
 struct DenoiseArgs {
   std::string input, methods, out;
-  std::string combine = "ensemble", reference;
+  std::string combine;  // empty: ensemble, or none for a single method
+  std::string reference;
   EnsembleFlags ensemble;
 };
 
-// What the combination step needs, from any of the three input forms.
-struct LoadedInput {
-  std::string kind;  // "render.exr", "outputs directory", "tungsten directory"
-  EnsembleGuides guides;
-  std::vector<BaseOutputs> bases;
+// An input as read, before any member runs: the buffers built-in members run on (a render.exr's
+// sub-buffers or a Tungsten directory's full buffer with its halves), or the finished outputs of
+// an outputs directory.
+struct ReadInput {
+  fs::path path;
+  std::string kind;  // "render.exr", "tungsten directory", "outputs directory"
+  std::optional<SampleBuffers> render;
+  std::optional<DenoiseInput> tungsten;
+  std::optional<OutputsDirectory> outputs;
+
+  int width() const {
+    return render ? render->width() : tungsten ? tungsten->width() : outputs->guides.width();
+  }
+  int height() const {
+    return render ? render->height() : tungsten ? tungsten->height() : outputs->guides.height();
+  }
+};
+
+ReadInput readInput(const fs::path& path, const std::vector<std::string>& specs) {
+  ReadInput input;
+  input.path = path;
+  if (fs::is_regular_file(path)) {
+    input.kind = "render.exr";
+    input.render = sampleBuffersFromLayers(readExr(path), path);
+    return input;
+  }
+  if (!fs::is_directory(path)) throw fileError(path, "no such file or directory");
+  bool anyFolder = false;
+  for (const std::string& spec : specs) anyFolder = anyFolder || fs::is_directory(path / spec);
+  if (anyFolder || (isOutputsDirectory(path) && !isTungstenDirectory(path))) {
+    input.kind = "outputs directory";
+    input.outputs = readOutputsDirectory(path, specs);
+    return input;
+  }
+  if (isTungstenDirectory(path)) {
+    input.kind = "tungsten directory";
+    input.tungsten = readTungstenDirectory(path);
+    return input;
+  }
+  throw fileError(path,
+                  "is neither a render.exr, a directory of base outputs (color.exr, colorA.exr, "
+                  "colorB.exr, <method>/…) nor a Tungsten buffer directory");
+}
+
+// What an error about the input's buffers adds: how to get an input that feeds the member.
+std::string inputHint(const ReadInput& input, bool alone) {
+  if (input.render && input.render->splitCount() == 1)
+    return alone ? "; this render.exr holds 1 sub-buffer: render without --splits 1"
+                 : "; this render.exr holds 1 sub-buffer: render without --splits 1, or run "
+                   "each member alone with --combine none";
+  if (alone) return "";
+  if (input.render && input.render->splitCount() < 4)
+    return "; render with --splits 4, or run it alone with --combine none";
+  return "; run it alone on the full buffer with --combine none";
+}
+
+// Member outputs and the timings of their runs.
+struct MemberRuns {
+  std::vector<BaseOutputs> bases;  // alone: only `full` is set
   std::vector<StageTime> times;
 };
 
-LoadedInput runBuiltins(const EnsembleSources& sources, const std::vector<std::string>& specs,
-                        const std::string& kind, const fs::path& input) {
-  const std::vector<EnsembleMember> members = fileSafeMembers(specs);
-  LoadedInput loaded;
-  loaded.kind = kind;
-  try {
-    checkMembersCanRun(sources, members);
-  } catch (const Error& e) {
-    throw fileError(input, e.what());
+// --combine none: each member alone on the full buffer (an outputs directory's full outputs are
+// taken as they are).
+MemberRuns runAlone(ReadInput& input, const std::vector<std::string>& specs) {
+  MemberRuns runs;
+  if (input.outputs) {
+    runs.bases = std::move(input.outputs->bases);
+    return runs;
   }
-  loaded.bases = runBaseDenoisers(sources, members, &loaded.times);
-  loaded.guides = guidesFromSources(sources);
-  return loaded;
+  const std::vector<EnsembleMember> members = fileSafeMembers(specs);
+  std::optional<DenoiseInput> merged;  // a render's full buffer and its halves A and B
+  if (input.render) merged = input.render->input(BufferPart::Full);
+  const DenoiseInput& full = merged ? *merged : *input.tungsten;
+  try {
+    checkMembersCanRunAlone(full, members);
+  } catch (const Error& e) {
+    throw fileError(input.path, e.what() + inputHint(input, true));
+  }
+  std::vector<Image> images = runMembersAlone(full, members, &runs.times);
+  for (size_t m = 0; m < members.size(); ++m)
+    runs.bases.push_back({members[m].label, {}, {}, std::move(images[m])});
+  return runs;
 }
 
-LoadedInput loadInput(const fs::path& input, const std::vector<std::string>& specs) {
-  if (fs::is_regular_file(input)) {
-    const SampleBuffers buffers = sampleBuffersFromLayers(readExr(input), input);
-    EnsembleSources sources;
-    try {
-      sources = sourcesFromBuffers(buffers);
-    } catch (const Error& e) {
-      throw fileError(input, std::string(e.what()) + " (render with --splits 4)");
+// Every member on half A, half B and the full buffer, for the combiners.
+MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& specs,
+                          EnsembleGuides* guides) {
+  MemberRuns runs;
+  if (input.outputs) {
+    runs.bases = std::move(input.outputs->bases);
+    *guides = std::move(input.outputs->guides);
+    return runs;
+  }
+  const std::vector<EnsembleMember> members = fileSafeMembers(specs);
+  EnsembleSources sources;
+  try {
+    sources = input.render ? sourcesFromBuffers(*input.render) : sourcesFromHalves(*input.tungsten);
+    checkMembersCanRun(sources, members);
+  } catch (const Error& e) {
+    throw fileError(input.path, e.what() + inputHint(input, false));
+  }
+  runs.bases = runBaseDenoisers(sources, members, &runs.times);
+  *guides = guidesFromSources(sources);
+  return runs;
+}
+
+// The noisy full-buffer colour, for the metrics of the input.
+Image noisyColor(const ReadInput& input) {
+  if (input.outputs) return input.outputs->guides.color;
+  if (input.tungsten) return input.tungsten->whole.color.mean;
+  return input.render->part(BufferPart::Full).color.mean;
+}
+
+// The combiners of --combine; none of them for --combine none (or no --combine and one method).
+std::vector<Combiner> combinersOf(const std::string& list, size_t methodCount) {
+  if (list.empty())
+    return methodCount == 1 ? std::vector<Combiner>{} : std::vector{Combiner::Ensemble};
+  const std::vector<std::string> names = splitMethodList(list);
+  std::vector<Combiner> combiners;
+  for (const std::string& name : names) {
+    if (name != "none") {
+      combiners.push_back(parseCombiner(name));
+      continue;
     }
-    return runBuiltins(sources, specs, "render.exr", input);
+    if (names.size() > 1)
+      throw Error("--combine none runs each method alone: it cannot be listed with combiners");
   }
-  if (!fs::is_directory(input)) throw fileError(input, "no such file or directory");
-  bool anyFolder = false;
-  for (const std::string& spec : specs) anyFolder = anyFolder || fs::is_directory(input / spec);
-  if (anyFolder || (isOutputsDirectory(input) && !isTungstenDirectory(input))) {
-    LoadedInput loaded;
-    loaded.kind = "outputs directory";
-    OutputsDirectory dir = readOutputsDirectory(input, specs);
-    loaded.guides = std::move(dir.guides);
-    loaded.bases = std::move(dir.bases);
-    return loaded;
-  }
-  if (isTungstenDirectory(input))
-    return runBuiltins(sourcesFromHalves(readTungstenDirectory(input)), specs, "tungsten directory",
-                       input);
-  throw fileError(input,
-                  "is neither a render.exr, a directory of base outputs (color.exr, colorA.exr, "
-                  "colorB.exr, <method>/…) nor a Tungsten buffer directory");
+  return combiners;
+}
+
+void writeStats(const fs::path& out, Json& stats, Json& times, const Stopwatch& total) {
+  times["total"] = total.seconds();
+  stats["seconds"] = times;
+  writeTextAtomically(out / "stats.json", stats.dump(2) + "\n");
+  std::cout << "wrote " << (out / "stats.json").string() << "\n";
 }
 
 void runDenoise(const DenoiseArgs& args) {
   const Stopwatch total;
   const std::vector<std::string> specs = splitMethodList(args.methods);
-  std::vector<Combiner> combiners;
-  for (const std::string& name : splitMethodList(args.combine))
-    combiners.push_back(parseCombiner(name));
+  const std::vector<Combiner> combiners = combinersOf(args.combine, specs.size());
   const CombineOptions options = args.ensemble.options();
   const fs::path out = args.out;
+  const OwnedDirectory owned(out);  // one run at a time in DIR
 
-  LoadedInput input = loadInput(args.input, specs);
+  ReadInput input = readInput(args.input, specs);
   std::optional<Image> reference;
   if (!args.reference.empty()) {
     reference = readRgbExr(args.reference);
-    checkReferenceSize(*reference, args.reference, input.guides.width(), input.guides.height());
+    requireFinitePixels(*reference, args.reference);
+    checkReferenceSize(*reference, args.reference, input.width(), input.height());
   }
   for (Combiner c : combiners)
     if (needsReference(c) && !reference)
       throw Error("--combine " + std::string(combinerName(c)) + " needs --reference");
-  input.times.insert(input.times.begin(), {"read", total.seconds()});
-  checkEnsembleInputs(input.guides, pointersTo(input.bases));
-  ensureDirectory(out);
+  const double readSeconds = total.seconds();
 
   Json stats;
   stats["input"] = args.input;
   stats["input_kind"] = input.kind;
-  stats["width"] = input.guides.width();
-  stats["height"] = input.guides.height();
+  stats["width"] = input.width();
+  stats["height"] = input.height();
   stats["methods"] = specs;
+  Json combinerNames = Json::array();
+  for (Combiner c : combiners) combinerNames.push_back(combinerName(c));
+  stats["combine"] = combiners.empty() ? Json("none") : combinerNames;
+  Json times = Json::object(), metrics = Json::object();
+  times["read"] = readSeconds;
+  if (reference) {
+    stats["reference"] = args.reference;
+    metrics["noisy"] = metricsJson(noisyColor(input), *reference);
+  }
+
+  if (combiners.empty()) {
+    const MemberRuns runs = runAlone(input, specs);
+    for (const StageTime& t : runs.times) times[t.stage] = t.seconds;
+    ensureDirectory(out);
+    const Stopwatch write;
+    for (const BaseOutputs& base : runs.bases) {
+      writeExr(out / (base.name + ".exr"), base.full);
+      writePng(out / (base.name + ".png"), base.full);
+      if (reference) metrics[base.name] = metricsJson(base.full, *reference);
+      std::cout << "wrote " << (out / (base.name + ".exr")).string() << "\n";
+    }
+    times["write"] = write.seconds();
+    if (reference) stats["metrics"] = metrics;
+    return writeStats(out, stats, times, total);
+  }
+
+  EnsembleGuides guides;
+  const MemberRuns runs = runForEnsemble(input, specs, &guides);
+  for (const StageTime& t : runs.times) times[t.stage] = t.seconds;
+  checkEnsembleInputs(guides, pointersTo(runs.bases));
+  ensureDirectory(out);
   stats["options"] = combineOptionsJson(options);
   stats["options"].erase("combine");  // one run per --combine value
-  Json times = Json::object(), metrics = Json::object();
-  for (const StageTime& t : input.times) times[t.stage] = t.seconds;
   for (size_t k = 0; k < combiners.size(); ++k) {
     CombineOptions o = options;
     o.combiner = combiners[k];
     const std::string name(combinerName(o.combiner));
     const CombineResult result =
-        combine(input.guides, pointersTo(input.bases), o, reference ? &*reference : nullptr);
+        combine(guides, pointersTo(runs.bases), o, reference ? &*reference : nullptr);
     for (const StageTime& t : result.times) times[name + "/" + t.stage] = t.seconds;
     const Stopwatch write;
-    writeCombined(out, name, result, input.bases,
+    writeCombined(out, name, result, runs.bases,
                   k == 0 ? "weights.exr" : "weights-" + name + ".exr");
     times[name + "/write"] = write.seconds();
     if (reference) metrics[name] = metricsJson(result.image, *reference);
@@ -143,44 +260,44 @@ void runDenoise(const DenoiseArgs& args) {
     std::cout << "wrote " << (out / (name + ".exr")).string() << "\n";
   }
   const Stopwatch writeBases;
-  writeBaseOutputs(out, input.bases);
+  writeBaseOutputs(out, runs.bases);
   times["write bases"] = writeBases.seconds();
   if (reference) {
-    metrics["noisy"] = metricsJson(input.guides.color, *reference);
-    for (const BaseOutputs& base : input.bases)
+    for (const BaseOutputs& base : runs.bases)
       metrics[base.name] = metricsJson(base.full, *reference);
-    stats["reference"] = args.reference;
     stats["metrics"] = metrics;
   }
-  times["total"] = total.seconds();
-  stats["seconds"] = times;
-  writeTextAtomically(out / "stats.json", stats.dump(2) + "\n");
-  std::cout << "wrote " << (out / "stats.json").string() << "\n";
+  writeStats(out, stats, times, total);
 }
 
 const RegisterCommand registration(40, [](CLI::App& app) {
   auto args = std::make_shared<DenoiseArgs>();
   CLI::App* cmd = app.add_subcommand(
       "denoise",
-      "Run base denoisers on half A, half B and the full buffer and blend them per pixel "
-      "(ensemble, Zheng et al. 2021) or with another combiner");
+      "Run base denoisers alone on the full buffer (--combine none, the default for one method), "
+      "or on half A, half B and the full buffer blended per pixel (ensemble, Zheng et al. 2021) "
+      "or by another combiner");
   cmd->add_option("input", args->input,
-                  "render.exr from `chorus render`, a directory of base outputs "
-                  "(color.exr colorA.exr colorB.exr albedo.exr normal.exr <m>/<m>{,A,B}.exr) "
-                  "or a Tungsten buffer directory")
+                  "render.exr from `chorus render`, a Tungsten buffer directory, or a directory "
+                  "of base outputs (color.exr colorA.exr colorB.exr albedo.exr normal.exr "
+                  "<m>/<m>{,A,B}.exr). Members that need two halves of their input (nfor, rdfc, "
+                  "nlm) run alone on a render.exr of 2 or more sub-buffers or a Tungsten "
+                  "directory, in the ensemble on a render.exr of 4; the others on any input")
       ->required();
   cmd->add_option("--methods", args->methods,
                   "Comma-separated base denoisers: built-in specs (name or name:key=value) for a "
                   "render.exr or Tungsten directory, folder names for a directory of outputs")
       ->required();
-  cmd->add_option("--out", args->out, "Output directory")->required();
+  cmd->add_option("--out", args->out, "Output directory")->required()->transform(nonEmpty());
   cmd->add_option("--combine", args->combine,
-                  "Combiner, or a comma-separated list: ensemble, average, onehot-pre, "
-                  "onehot-post, oracle, oracle-unconstrained (oracles need --reference)")
-      ->capture_default_str();
+                  "none (each method alone on the full buffer: DIR/<method>.exr/.png), or a "
+                  "combiner or comma-separated list of them: ensemble, average, onehot-pre, "
+                  "onehot-post, oracle, oracle-unconstrained (oracles need --reference). "
+                  "Default: none for one method, else ensemble");
   args->ensemble.addFlags(*cmd);
   cmd->add_option("--reference", args->reference,
-                  "Reference image (.exr): metrics in stats.json, and the oracle combiners");
+                  "Reference image (.exr): relMSE, DSSIM and PSNR of the noisy input, each member "
+                  "and each combination in stats.json, and the oracle combiners");
   cmd->callback([args] { runDenoise(*args); });
 });
 

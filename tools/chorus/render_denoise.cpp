@@ -57,6 +57,12 @@ double DenoiseStage::run(const EnsembleSources& sources, const std::filesystem::
   return denoiseSeconds;
 }
 
+int DenoiseStage::splitsNeeded() const {
+  if (enabled()) return chorus::splitsNeeded(members);
+  if (!writeExrs) return 1;
+  return chorus::splitsNeeded(fileSafeMembers(splitMethodList(kDefaultDenoise)));
+}
+
 std::string DenoiseStage::label() const {
   std::string text;
   for (const std::string& spec : specs) text += (text.empty() ? "" : ",") + spec;

@@ -43,8 +43,10 @@ struct DenoiseStage {
 
   std::string label() const;  // "nfor,rdfc,..."
   bool enabled() const { return !specs.empty(); }
-  // Sub-buffers the render needs (chorus::splitsNeeded of the members; 1 without denoising).
-  int splitsNeeded() const { return enabled() ? chorus::splitsNeeded(members) : 1; }
+  // Sub-buffers the render needs: chorus::splitsNeeded of the members. Without denoising, what
+  // the default members need, so that `chorus denoise render.exr` can run them later (render
+  // now, denoise later); 1 for a preview, which writes no render.exr.
+  int splitsNeeded() const;
 
   // Runs the members and the combiner on `sources` (sourcesFromBuffers of the render),
   // writes denoised.png and, unless a preview, denoised.exr, weights.exr and <member>.exr to

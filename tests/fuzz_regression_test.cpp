@@ -8,7 +8,6 @@
 
 #include <array>
 #include <cstdio>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -17,43 +16,6 @@
 namespace chorus {
 namespace {
 namespace fs = std::filesystem;
-
-// Inputs the issue-27 fixes (loaders, flags) have not yet made clean on this branch: skipped,
-// not run (several hang until their timeout). Empty this list once the fixes are merged; a
-// fixed input that still fails then shows here as a failing test.
-const std::set<std::string> kKnownFailing = {
-    "cli/compare-nan-pixel",
-    "cli/compare-nan-pixel-json",
-    "cli/env-intensity-nan",
-    "cli/env-rotate-inf",
-    "cli/env-rotate-nan",
-    "cli/out-empty",
-    "cli/reference-wrong-size",
-    "cli/seed-2p64",
-    "cli/seed-minus-1",
-    "cli/spp-minus-1-message-length",
-    "cli/sweep-all-nan-reference",
-    "cli/sweep-bad-scene-leaves-files",
-    "cli/sweep-reference-seconds-nan",
-    "cli/width-100000",
-    "cli/width-65536-height-65536",
-    "cli/window-1000000",
-    "environment/truncated-rle.hdr",
-    "exr/tungsten-meta-spp-negative",
-    "gltf/accessor-count-2p32.gltf",
-    "gltf/accessor-count-2p62.gltf",
-    "gltf/accessor-count-2p63.gltf",
-    "gltf/accessor-count-2p64-plus-2-div-3.gltf",
-    "gltf/buffer-uri-directory.gltf",
-    "gltf/buffer-uri-fifo",
-    "gltf/camera-at-1e20.gltf",
-    "gltf/extras-nested-24000-deep.gltf",
-    "gltf/index-count-2p63.gltf",
-    "gltf/node-dag-24-levels.gltf",
-    "gltf/orthographic-ymag-1e20.gltf",
-    // The short run meets the same findings within its first few hundred inputs.
-    "short-run",
-};
 
 fs::path driver() {
   return fs::path(CHORUS_BINARY).parent_path() / "fuzz" / "fuzz_inputs";
@@ -98,8 +60,6 @@ std::vector<std::string> regressionInputs() {
 class FuzzRegression : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(FuzzRegression, IsRejectedOrHandledCleanly) {
-  if (kKnownFailing.count(GetParam()))
-    GTEST_SKIP() << "known failing until the issue-27 fixes merge";
   ASSERT_TRUE(fs::is_regular_file(driver())) << "build the fuzz_inputs target";
   test::TempDir work("chorus_fuzz_regression");
   const DriverRun run = runDriver({"--replay", (regressionDir() / GetParam()).string(), "--work",
@@ -144,8 +104,6 @@ TEST(FuzzDriver, CasesAreDeterministic) {
 
 // A short run over every target, fixed seed; bounded by count and, on a slow machine, time.
 TEST(FuzzDriver, ShortRunFindsNothing) {
-  if (kKnownFailing.count("short-run"))
-    GTEST_SKIP() << "known failing until the issue-27 fixes merge";
   ASSERT_TRUE(fs::is_regular_file(driver())) << "build the fuzz_inputs target";
   test::TempDir work("chorus_fuzz_short");
   const DriverRun run = runDriver({"--seed", "1", "--count", "240", "--seconds", "25", "--work",

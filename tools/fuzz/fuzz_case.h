@@ -42,6 +42,7 @@ struct Outcome {
   Verdict verdict = Verdict::Ok;
   std::string summary;  // one line
   std::string log;      // what the child printed on stderr (findings only)
+  bool timedOut = false;
 };
 
 // Writes the case's files (and args.txt) into `dir`, creating it. FIFOs are created as such to

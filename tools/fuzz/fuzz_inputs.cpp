@@ -84,15 +84,30 @@ class Driver {
                                  : generateFileCase(target, seeds_, rng);
   }
 
+  // A loaded machine (parallel builds and tests) can push a slow but finite case past its
+  // timeout: a case that timed out runs once more with kRetryFactor times the time before its
+  // timeout counts as a hang. A real hang hangs again.
   Outcome run(const FuzzCase& fuzzCase) {
-    const fs::path dir = work_ / "case";
-    fs::remove_all(dir);
-    writeCase(fuzzCase, dir);
-    if (fuzzCase.target == Target::Cli) return runCliCase(fuzzCase, cli(), dir, cliLimits_);
-    return runInChild([&] { return checkFileCase(fuzzCase, dir); }, limits_, dir / "child.log");
+    const Outcome outcome = runWithin(fuzzCase, 1);
+    return outcome.timedOut ? runWithin(fuzzCase, kRetryFactor) : outcome;
   }
 
  private:
+  static constexpr double kRetryFactor = 4;
+
+  Outcome runWithin(const FuzzCase& fuzzCase, double timeFactor) {
+    const fs::path dir = work_ / "case";
+    fs::remove_all(dir);
+    writeCase(fuzzCase, dir);
+    const auto scaled = [&](ChildLimits limits) {
+      limits.timeoutSeconds *= timeFactor;
+      return limits;
+    };
+    if (fuzzCase.target == Target::Cli) return runCliCase(fuzzCase, cli(), dir, scaled(cliLimits_));
+    return runInChild([&] { return checkFileCase(fuzzCase, dir); }, scaled(limits_),
+                      dir / "child.log");
+  }
+
   const CliFixtures& cli() {
     if (!cli_)
       cli_ = prepareCliFixtures(settings_.chorus, settings_.source, work_ / "seeds",

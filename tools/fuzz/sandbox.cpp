@@ -174,6 +174,7 @@ Outcome runInChild(const std::function<std::string()>& body, const ChildLimits& 
         break;
     }
   } else if (timedOut) {
+    outcome.timedOut = true;
     outcome.summary = "hang: no result after " + std::to_string(int(limits.timeoutSeconds)) + " s";
   } else if (WIFSIGNALED(status)) {
     outcome.summary = "crash: " + signalName(WTERMSIG(status));

@@ -278,12 +278,15 @@ bool asksForHugeWork(const std::vector<std::string>& args) {
   return false;
 }
 
-std::vector<std::string> errorLines(const std::string& err) {
+// What chorus printed on stderr but its warnings, CLI11's hint and the subcommand's progress
+// lines ("sweep: 1 case(s) in this shard, …" before the error).
+std::vector<std::string> errorLines(const std::string& err, const std::string& command) {
   std::vector<std::string> lines;
   std::istringstream in(err);
   for (std::string line; std::getline(in, line);) {
     if (line.empty() || line.starts_with("chorus: warning:") ||
-        line == "Run with --help for more information.")
+        line == "Run with --help for more information." ||
+        (!command.empty() && line.starts_with(command + ": ")))
       continue;
     lines.push_back(line);
   }
@@ -520,7 +523,8 @@ Outcome runCliCase(const FuzzCase& fuzzCase, const CliFixtures& fixtures, const 
       outcome.summary += " (" + s + ")";
     return outcome;
   }
-  const std::vector<std::string> errors = errorLines(run.err);
+  const std::string command = fuzzCase.args.empty() ? "" : fuzzCase.args[0];
+  const std::vector<std::string> errors = errorLines(run.err, command);
   if (run.exitCode == 2) {
     if (errors.size() != 1) {
       outcome.summary = "exit 2 with " + std::to_string(errors.size()) + " error lines";
@@ -540,7 +544,6 @@ Outcome runCliCase(const FuzzCase& fuzzCase, const CliFixtures& fixtures, const 
       outcome.summary += " (" + s + ")";
     return outcome;
   }
-  const std::string command = fuzzCase.args.empty() ? "" : fuzzCase.args[0];
   for (const auto& [flag, value] : values) {
     if (!isPathFlag(flag) && !flagType(fixtures, command, flag).empty() && mentionsNan(value)) {
       outcome.summary = "exit 0 with " + flag + " " + value.substr(0, 60);

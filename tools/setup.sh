@@ -5,12 +5,11 @@
 #   tools/setup.sh build  install missing packages and build only
 #   tools/setup.sh bench  also install the renderer benchmark's peer (embree-tools), build,
 #                         run build/bench/bench_render (about 3 minutes after the build)
-#   tools/setup.sh sanitize  build the unit tests, chorus and the fuzzer with AddressSanitizer
-#                         and UBSan in build-asan/ (-O1, no benchmarks) and run the unit tests,
-#                         which include the fuzz regression inputs (docs/fuzzing.md)
+#   tools/setup.sh sanitize  build chorus, the fuzzer and the input-facing unit tests with
+#                         AddressSanitizer and UBSan in build-asan/ (-O1) and run them, the fuzz
+#                         regression inputs included (docs/fuzzing.md); .ci/run runs it after test
 # Environment: BUILD_DIR (default build; build-asan for sanitize), JOBS (default: number of
-# cores), CI=true adds -Werror (not to the sanitizer build: the instrumentation makes GCC warn
-# inside its own intrinsics headers).
+# cores), CI=true adds -Werror.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -45,19 +44,15 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
+werror=OFF
+[ "${CI:-}" = "true" ] && werror=ON
 if [ "$mode" = sanitize ]; then
+  # A CHORUS_ASAN build configures only the sanitizer's tests (tests/CMakeLists.txt); of the
+  # tools only chorus and the fuzzer, which they run, are built.
   cmake -S . -B "$build_dir" -DCHORUS_ASAN=ON -DCMAKE_BUILD_TYPE=Sanitize \
-    -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -DNDEBUG" > /dev/null
-  # Only what the unit tests run: chorus, the fuzzer and every test but the slow ones.
-  targets=(chorus fuzz_inputs)
-  for t in tests/*_test.cpp; do
-    name=$(basename "$t" .cpp)
-    [[ $name == *_slow_test ]] || targets+=("$name")
-  done
-  cmake --build "$build_dir" -j "$jobs" --target "${targets[@]}"
+    -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -DNDEBUG" -DCHORUS_WERROR=$werror > /dev/null
+  cmake --build "$build_dir" -j "$jobs" --target sanitizer_tests
 else
-  werror=OFF
-  [ "${CI:-}" = "true" ] && werror=ON
   cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCHORUS_WERROR=$werror > /dev/null
   cmake --build "$build_dir" -j "$jobs"
 fi
@@ -71,8 +66,7 @@ case "$mode" in
     "$build_dir"/bench/bench_render
     ;;
   sanitize)
-    # `-L unit`: the slow tests are not built here (CTest lists them as *_NOT_BUILT, unlabelled).
-    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -L unit
+    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
     ;;
   demo)
     out=out/cornell-box

@@ -5,19 +5,24 @@
 #   tools/setup.sh build  install missing packages and build only
 #   tools/setup.sh bench  also install the renderer benchmark's peer (embree-tools), build,
 #                         run build/bench/bench_render (about 3 minutes after the build)
-# Environment: BUILD_DIR (default build), JOBS (default: number of cores), CI=true adds -Werror.
+#   tools/setup.sh sanitize  build chorus, the fuzzer and the input-facing unit tests with
+#                         AddressSanitizer and UBSan in build-asan/ (-O1) and run them, the fuzz
+#                         regression inputs included (docs/fuzzing.md); .ci/run runs it after test
+# Environment: BUILD_DIR (default build; build-asan for sanitize), JOBS (default: number of
+# cores), CI=true adds -Werror.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 mode=${1:-demo}
 case "$mode" in
-  demo | test | build | bench) ;;
+  demo | test | build | bench | sanitize) ;;
   *)
-    echo "usage: tools/setup.sh [demo|test|build|bench]" >&2
+    echo "usage: tools/setup.sh [demo|test|build|bench|sanitize]" >&2
     exit 2
     ;;
 esac
 build_dir=${BUILD_DIR:-build}
+[ "$mode" = sanitize ] && build_dir=${BUILD_DIR:-build-asan}
 jobs=${JOBS:-$(nproc)}
 
 packages=(g++ cmake make pkg-config libembree-dev libtinygltf-dev libopenexr-dev libtbb-dev
@@ -41,8 +46,16 @@ fi
 
 werror=OFF
 [ "${CI:-}" = "true" ] && werror=ON
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCHORUS_WERROR=$werror > /dev/null
-cmake --build "$build_dir" -j "$jobs"
+if [ "$mode" = sanitize ]; then
+  # A CHORUS_ASAN build configures only the sanitizer's tests (tests/CMakeLists.txt); of the
+  # tools only chorus and the fuzzer, which they run, are built.
+  cmake -S . -B "$build_dir" -DCHORUS_ASAN=ON -DCMAKE_BUILD_TYPE=Sanitize \
+    -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -DNDEBUG" -DCHORUS_WERROR=$werror > /dev/null
+  cmake --build "$build_dir" -j "$jobs" --target sanitizer_tests
+else
+  cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCHORUS_WERROR=$werror > /dev/null
+  cmake --build "$build_dir" -j "$jobs"
+fi
 
 case "$mode" in
   build) ;;
@@ -51,6 +64,9 @@ case "$mode" in
     ;;
   bench)
     "$build_dir"/bench/bench_render
+    ;;
+  sanitize)
+    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
     ;;
   demo)
     out=out/cornell-box

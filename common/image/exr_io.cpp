@@ -217,9 +217,21 @@ Image readExrLayer(const fs::path& path, const std::string& name) {
   for (ExrLayer& layer : layers)
     if (layer.name == name) return std::move(layer.image);
   if (name.empty() && layers.size() == 1) return std::move(layers[0].image);
+  // Layers "sub0.color", "sub0.albedo", … listed as "sub0.*" (a render.exr has ~50 layers).
+  std::vector<std::string> shown;
+  for (const ExrLayer& layer : layers) {
+    const size_t dot = layer.name.find('.');
+    const std::string entry = layer.name.empty()         ? "<default>"
+                              : dot == std::string::npos ? layer.name
+                                                         : layer.name.substr(0, dot) + ".*";
+    if (std::find(shown.begin(), shown.end(), entry) == shown.end()) shown.push_back(entry);
+  }
+  constexpr size_t kListed = 16;  // one readable error line, whatever the file holds
   std::string available;
-  for (const ExrLayer& layer : layers)
-    available += (available.empty() ? "" : ", ") + (layer.name.empty() ? "<default>" : layer.name);
+  for (size_t i = 0; i < std::min(shown.size(), kListed); ++i)
+    available += (i == 0 ? "" : ", ") + shown[i];
+  if (shown.size() > kListed)
+    available += ", … (" + std::to_string(shown.size() - kListed) + " more)";
   throw fileError(
       path, "no layer '" + (name.empty() ? "<default>" : name) + "' (layers: " + available + ")");
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <new>
+#include <optional>
 #include <set>
 
 #include "common/error.h"
@@ -57,6 +58,15 @@ void checkRadiance(double v, const std::string& what) {
 }
 
 // Adds `amount` to a count bounded by `limit`; `what` names the count for the error message.
+const char* const kNodeInstancesWhat = "node instances (a node counts once per path from the root)";
+const char* const kPrimitiveInstancesWhat = "mesh primitive instances";
+
+// Points and lines are skipped (chorus renders triangles); -1 is glTF's default, triangles.
+bool isTriangleMode(int mode) {
+  return mode < 0 || mode == TINYGLTF_MODE_TRIANGLES || mode == TINYGLTF_MODE_TRIANGLE_STRIP ||
+         mode == TINYGLTF_MODE_TRIANGLE_FAN;
+}
+
 void addToBudget(size_t* used, size_t amount, size_t limit, const std::string& what) {
   if (amount > limit - *used)
     throw Error("has more than " + std::to_string(limit) + " " + what +
@@ -117,6 +127,7 @@ class SceneBuilder {
       for (size_t i = 0; i < model_.nodes.size(); ++i)
         if (!isChild[i]) roots.push_back(int(i));
     }
+    checkInstanceCounts(roots);
     for (int root : roots) visit(root, Transform(), 0);
     materials_.decodeImages();
     if (skippedPrimitives_ > 0)
@@ -127,13 +138,56 @@ class SceneBuilder {
   }
 
  private:
+  // Node and primitive instances below a node (itself included), saturated past the limits.
+  struct SubtreeInstances {
+    size_t nodes = 0, primitives = 0;
+  };
+
+  // The instance budgets checked from per-node counts before any node is visited: a DAG whose
+  // levels each list the next node twice has 2^levels paths, which visit() charges one by one
+  // (a million of them, seconds, before the budget ran out).
+  void checkInstanceCounts(const std::vector<int>& roots) {
+    std::vector<std::optional<SubtreeInstances>> counted(model_.nodes.size());
+    std::vector<bool> onPath(model_.nodes.size(), false);
+    size_t nodes = 0, primitives = 0;
+    for (int root : roots) {
+      const SubtreeInstances below = countInstances(root, 0, counted, onPath);
+      addToBudget(&nodes, below.nodes, kMaxNodeInstances, kNodeInstancesWhat);
+      addToBudget(&primitives, below.primitives, kMaxPrimitiveInstances, kPrimitiveInstancesWhat);
+    }
+  }
+
+  SubtreeInstances countInstances(int nodeIndex, int depth,
+                                  std::vector<std::optional<SubtreeInstances>>& counted,
+                                  std::vector<bool>& onPath) {
+    if (nodeIndex < 0 || size_t(nodeIndex) >= model_.nodes.size())
+      throw Error("refers to missing node " + std::to_string(nodeIndex));
+    const size_t n = size_t(nodeIndex);
+    if (depth > kMaxNodeDepth || onPath[n])
+      throw Error("node hierarchy is cyclic or deeper than " + std::to_string(kMaxNodeDepth));
+    if (counted[n]) return *counted[n];
+    onPath[n] = true;
+    const tinygltf::Node& node = model_.nodes[n];
+    SubtreeInstances sum{1, 0};
+    if (node.mesh >= 0 && size_t(node.mesh) < model_.meshes.size())
+      for (const tinygltf::Primitive& prim : model_.meshes[size_t(node.mesh)].primitives)
+        sum.primitives += isTriangleMode(prim.mode) ? 1 : 0;
+    for (int child : node.children) {
+      const SubtreeInstances below = countInstances(child, depth + 1, counted, onPath);
+      sum.nodes = std::min(sum.nodes + below.nodes, kMaxNodeInstances + 1);
+      sum.primitives = std::min(sum.primitives + below.primitives, kMaxPrimitiveInstances + 1);
+    }
+    onPath[n] = false;
+    counted[n] = sum;
+    return sum;
+  }
+
   void visit(int nodeIndex, const Transform& parent, int depth) {
     if (nodeIndex < 0 || size_t(nodeIndex) >= model_.nodes.size())
       throw Error("refers to missing node " + std::to_string(nodeIndex));
     if (depth > kMaxNodeDepth)
       throw Error("node hierarchy is cyclic or deeper than " + std::to_string(kMaxNodeDepth));
-    addToBudget(&nodeInstances_, 1, kMaxNodeInstances,
-                "node instances (a node counts once per path from the root)");
+    addToBudget(&nodeInstances_, 1, kMaxNodeInstances, kNodeInstancesWhat);
     const tinygltf::Node& node = model_.nodes[size_t(nodeIndex)];
     const Transform worldFromNode = parent * localTransform(node);
     const std::string label =
@@ -168,12 +222,11 @@ class SceneBuilder {
 
   void addPrimitive(const tinygltf::Primitive& prim, const std::string& label,
                     const Transform& worldFromObject) {
-    const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
-    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-        mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+    if (!isTriangleMode(prim.mode)) {
       ++skippedPrimitives_;
       return;
     }
+    const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
     const auto attribute = [&](const char* name) {
       const auto it = prim.attributes.find(name);
       return it == prim.attributes.end() ? -1 : it->second;
@@ -181,7 +234,7 @@ class SceneBuilder {
     const int positionAccessor = attribute("POSITION");
     if (positionAccessor < 0) throw Error(label + " has no POSITION");
 
-    addToBudget(&primitiveInstances_, 1, kMaxPrimitiveInstances, "mesh primitive instances");
+    addToBudget(&primitiveInstances_, 1, kMaxPrimitiveInstances, kPrimitiveInstancesWhat);
     // The budgets are charged from the accessor counts before any data is read or allocated.
     const size_t vertexCount = gltf::accessorCount(model_, positionAccessor, label + " POSITION");
     addToBudget(&vertices_, vertexCount, kMaxSceneVertices, "vertices over all instances");

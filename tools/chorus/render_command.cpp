@@ -208,6 +208,7 @@ const RegisterCommand registration(30, [](CLI::App& app) {
   cmd->add_option("--splits", args->splits,
                   "Independent sub-buffers K: 1, 2 or 4 (default: what --denoise needs; with "
                   "--denoise none, what the default members need, for a later `chorus denoise`)")
+      ->transform(integerIn(1, 4))  // refuses '' (CLI11 leaves the default for an empty value)
       ->check(CLI::IsMember({1, 2, 4}));
   args->sceneOptions.addFlags(*cmd);
   cmd->add_option("--denoise", args->denoise,

@@ -100,8 +100,8 @@ std::string sweepSettings(const SweepConfig& config) {
 }
 
 // Writes DIR/settings.txt, or throws chorus::Error naming it when DIR holds a sweep run with
-// other settings.
-void claimDirectory(const SweepConfig& config) {
+// other settings. Returns whether it wrote the file.
+bool claimDirectory(const SweepConfig& config) {
   const fs::path file = settingsPath(config.out);
   const std::string settings = sweepSettings(config);
   if (fs::exists(file)) {
@@ -109,10 +109,20 @@ void claimDirectory(const SweepConfig& config) {
       throw fileError(file,
                       "holds a sweep run with other settings (scene, reference or ensemble "
                       "flags): rerun with those, or use another --out");
-    return;
+    return false;
   }
   ensureDirectory(config.out);
   writeTextAtomically(file, settings);
+  return true;
+}
+
+// A new sweep that fails before it wrote a case or a reference (an unreadable scene, say)
+// leaves --out as it found it: its empty subdirectories and settings.txt go.
+void releaseUnusedClaim(const fs::path& out) {
+  std::error_code ec;
+  for (const char* sub : {"cases", "references"}) fs::remove(out / sub, ec);  // only when empty
+  if (!fs::exists(out / "cases", ec) && !fs::exists(out / "references", ec))
+    fs::remove(settingsPath(out), ec);
 }
 
 // The reference of a scene: the given file, else DIR/references/<scene>.exr, rendered once
@@ -281,23 +291,8 @@ int referenceSppFor(int spp, double seconds, int probeSpp, double probeSeconds) 
   return int(budget);
 }
 
-SweepRunStats runSweep(const SweepConfig& config) {
-  if (config.scenes.empty()) throw Error("no scenes given");
-  if (config.out.empty()) throw Error("no output directory given (--out)");
-  for (const fs::path& scene : config.scenes)
-    if (!fs::is_regular_file(scene)) throw fileError(scene, "no such file");
-  if (!config.references.empty() && config.references.size() != config.scenes.size())
-    throw Error("--reference given " + std::to_string(config.references.size()) + " times for " +
-                std::to_string(config.scenes.size()) + " scenes (one per scene, in scene order)");
-  for (const fs::path& reference : config.references) {
-    if (!fs::is_regular_file(reference)) throw fileError(reference, "no such file");
-    // A NaN in a reference makes every row's metrics NaN: refused before anything runs.
-    requireFinitePixels(readRgbExr(reference), reference);
-  }
-  if (config.cropSize < 1) throw Error("crop size must be positive");
-  const Plan plan = makePlan(config);
-  claimDirectory(config);
-
+// The sweep proper, once DIR is claimed.
+SweepRunStats runClaimedSweep(const SweepConfig& config, const Plan& plan) {
   const std::vector<SweepCase> all = planCases(config.scenes, config.spps);
   const std::vector<SweepCase> mine = casesOfShard(all, config.shard);
   SweepRunStats stats;
@@ -353,6 +348,30 @@ SweepRunStats runSweep(const SweepConfig& config) {
   }
   writeSweepSummary(config.out, config.report);
   return stats;
+}
+
+SweepRunStats runSweep(const SweepConfig& config) {
+  if (config.scenes.empty()) throw Error("no scenes given");
+  if (config.out.empty()) throw Error("no output directory given (--out)");
+  for (const fs::path& scene : config.scenes)
+    if (!fs::is_regular_file(scene)) throw fileError(scene, "no such file");
+  if (!config.references.empty() && config.references.size() != config.scenes.size())
+    throw Error("--reference given " + std::to_string(config.references.size()) + " times for " +
+                std::to_string(config.scenes.size()) + " scenes (one per scene, in scene order)");
+  for (const fs::path& reference : config.references) {
+    if (!fs::is_regular_file(reference)) throw fileError(reference, "no such file");
+    // A NaN in a reference makes every row's metrics NaN: refused before anything runs.
+    requireFinitePixels(readRgbExr(reference), reference);
+  }
+  if (config.cropSize < 1) throw Error("crop size must be positive");
+  const Plan plan = makePlan(config);
+  const bool claimed = claimDirectory(config);
+  try {
+    return runClaimedSweep(config, plan);
+  } catch (...) {
+    if (claimed) releaseUnusedClaim(config.out);
+    throw;
+  }
 }
 
 }  // namespace chorus::sweep

@@ -5,7 +5,8 @@
 //   3. radiance beyond float's comfortable range is divided by a power of two
 //      (radiance_scale.h) so that no squared term overflows, and multiplied back afterwards;
 //   4. the output is finite and not below min(0, input) at any pixel: non-finite values become
-//      the (guarded) noisy input's, and a member never makes non-negative radiance negative.
+//      the (guarded) noisy input's, and a member never makes non-negative radiance negative;
+//   5. pixels whose every sample missed the scene and agreed exactly keep their input.
 // Steps 1–3 change nothing on ordinary inputs; docs/outliers.md has the reasons.
 #include <memory>
 
@@ -31,5 +32,12 @@ class GuardedDenoiser : public BaseDenoiser {
 // In place: non-finite values of `output` become those of `noisy` (0 where that is not finite
 // either), then every value is raised to at least min(0, noisy). Same shape required.
 void finishOutput(Image& output, const Image& noisy);
+
+// In place: where every sample of `whole` missed the scene (feature depth 0: the path tracer's
+// miss) and the samples agree exactly (colour variance of the mean 0, at least 2 samples), the
+// output is the input there. Such a pixel is known exactly (a constant background); members
+// filled one-pixel holes in a silhouette with the object's radiance (the lamp corpus scene,
+// 16 spp: RDFC 20.8 where the reference is 0, 86 % of its error). No-op without depth or counts.
+void keepNoiseFreeMisses(Image& output, const SubBuffer& whole);
 
 }  // namespace chorus

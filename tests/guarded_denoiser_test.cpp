@@ -129,6 +129,24 @@ TEST(FinishOutput, FiniteAndNeverBelowZeroOrTheInput) {
   EXPECT_EQ(out(3, 0, 0), 0.0f);   // Inf and no finite input → 0
 }
 
+TEST(KeepWithinTheSamples, BoundsOnlyWellMeasuredPixels) {
+  // Mean 1, standard error 0.1, 16 samples: within 10 standard errors means [0, 2]. Pixel 2 has
+  // 4 samples and pixel 3 no variance: what their samples say is too little to bound anything.
+  SubBuffer whole = constantBuffer(4, 1, 1.0f);
+  whole.sampleCount.fill(16);
+  whole.sampleCount(2, 0, 0) = 4;
+  whole.color.varianceOfMean(3, 0, 0) = 0.0f;
+  Image out(4, 1, 3);
+  const float values[4] = {5.0f, -3.0f, 5.0f, 5.0f};
+  for (int x = 0; x < 4; ++x) out(x, 0, 0) = out(x, 0, 1) = out(x, 0, 2) = values[x];
+  keepWithinTheSamples(out, whole, 10.0);
+  EXPECT_NEAR(out(0, 0, 0), 2.0f, 1e-6);  // 0.01f is not exactly 0.01
+  EXPECT_NEAR(out(1, 0, 0), 0.0f, 1e-6);
+  EXPECT_EQ(out(2, 0, 0), 5.0f);
+  EXPECT_EQ(out(3, 0, 0), 5.0f);
+  EXPECT_NEAR(out(3, 0, 1), 2.0f, 1e-6);  // the other channels have their variance
+}
+
 TEST(KeepNoiseFreeMisses, OnlyExactMissesKeepTheirInput) {
   // Four pixels of an input at 0.25 (variance 0, 4 samples): (0) a miss, kept; (1) a miss with
   // noise, (2) a hit (depth 3), (3) a miss seen by one sample only: left to the member.

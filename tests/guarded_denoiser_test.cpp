@@ -129,6 +129,61 @@ TEST(FinishOutput, FiniteAndNeverBelowZeroOrTheInput) {
   EXPECT_EQ(out(3, 0, 0), 0.0f);   // Inf and no finite input → 0
 }
 
+TEST(KeepWithinTheSamples, BoundsOnlyWellMeasuredPixels) {
+  // Mean 1, standard error 0.1, 16 samples: within 10 standard errors means [0, 2]. Pixel 2 has
+  // 4 samples and pixel 3 no variance: what their samples say is too little to bound anything.
+  SubBuffer whole = constantBuffer(4, 1, 1.0f);
+  whole.sampleCount.fill(16);
+  whole.sampleCount(2, 0, 0) = 4;
+  whole.color.varianceOfMean(3, 0, 0) = 0.0f;
+  Image out(4, 1, 3);
+  const float values[4] = {5.0f, -3.0f, 5.0f, 5.0f};
+  for (int x = 0; x < 4; ++x) out(x, 0, 0) = out(x, 0, 1) = out(x, 0, 2) = values[x];
+  keepWithinTheSamples(out, whole, 10.0);
+  EXPECT_NEAR(out(0, 0, 0), 2.0f, 1e-6);  // 0.01f is not exactly 0.01
+  EXPECT_NEAR(out(1, 0, 0), 0.0f, 1e-6);
+  EXPECT_EQ(out(2, 0, 0), 5.0f);
+  EXPECT_EQ(out(3, 0, 0), 5.0f);
+  EXPECT_NEAR(out(3, 0, 1), 2.0f, 1e-6);  // the other channels have their variance
+}
+
+TEST(KeepNoiseFreeMisses, OnlyExactMissesKeepTheirInput) {
+  // Four pixels of an input at 0.25 (variance 0, 4 samples): (0) a miss, kept; (1) a miss with
+  // noise, (2) a hit (depth 3), (3) a miss seen by one sample only: left to the member.
+  SubBuffer whole = constantBuffer(4, 1, 0.25f);
+  whole.color.varianceOfMean.fill(0.0f);
+  whole.color.varianceOfMean(1, 0, 2) = 1e-3f;
+  whole.depth.mean(2, 0, 0) = 3.0f;
+  whole.sampleCount(3, 0, 0) = 1.0f;
+  Image out(4, 1, 3);
+  out.fill(7.0f);
+  keepNoiseFreeMisses(out, whole);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_EQ(out(0, 0, c), 0.25f);
+    for (int x = 1; x < 4; ++x) EXPECT_EQ(out(x, 0, c), 7.0f) << x;
+  }
+}
+
+TEST(GuardedDenoiser, OnePixelHoleInASilhouetteStaysBlack) {
+  // A bright surface (depth 2, radiance 10 ± noise) with one pixel that every sample saw as a
+  // miss of a black background: a blurring member must not fill it.
+  SubBuffer whole = constantBuffer(16, 16, 10.0f);
+  whole.depth.mean.fill(2.0f);
+  whole.albedo.mean.fill(0.5f);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) whole.color.mean(x, y, 1) += 0.5f * float((x * 7 + y * 3) % 5);
+  for (int c = 0; c < 3; ++c) {
+    whole.color.mean(8, 8, c) = whole.color.varianceOfMean(8, 8, c) = 0.0f;
+    whole.albedo.mean(8, 8, c) = 0.0f;
+  }
+  whole.depth.mean(8, 8, 0) = 0.0f;
+  DenoiseInput in;
+  in.whole = whole;
+  const Image out = createDenoiser("atrous")->run(in);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(out(8, 8, c), 0.0f);
+  EXPECT_GT(out(7, 8, 0), 5.0f);
+}
+
 TEST(GuardedDenoiser, RegistryMembersKeepTheirNamesAndRequirements) {
   for (const DenoiserEntry& entry : builtinDenoisers()) {
     ParamMap none;

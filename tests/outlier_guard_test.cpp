@@ -127,6 +127,26 @@ TEST(OutlierGuard, FirefliesWithPeersKeepTheirEnergy) {
   EXPECT_LT(largest, 0.2f * 300.0f / 4.0f);
 }
 
+TEST(OutlierGuard, SpreadStaysOnTheOutliersSurface) {
+  // The caustic of FirefliesWithPeersKeepTheirEnergy on a surface at depth 2 that ends at
+  // x = 20; beyond it every sample misses (depth 0) a black background. The spread keeps the
+  // energy on the surface: the background stays black and the surface's sum is kept.
+  SubBuffer s = fromSamples(40, 40, [](int x, int y) {
+    if (x >= 20) return std::vector<double>{0, 0, 0, 0};
+    std::vector<double> v = ordinary(x, y, 4);
+    if (x >= 12 && y >= 12 && y < 28 && (3 * x + 5 * y) % 11 == 0) v[0] = 300.0;
+    return v;
+  });
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 20; ++x) s.depth.mean(x, y, 0) = 2.0f;
+  const GuardedInput g = guardOutliers(wholeOnly(s));
+  ASSERT_GT(g.clampedValues, 0u);
+  for (int y = 0; y < 40; ++y)
+    for (int x = 20; x < 40; ++x) ASSERT_LT(g.input.whole.color.mean(x, y, 0), 1e-12f) << x << y;
+  const double before = channelSum(s.color.mean), after = channelSum(g.input.whole.color.mean);
+  EXPECT_NEAR(after, before, 1e-5 * before);
+}
+
 TEST(OutlierGuard, TheWholeIsTheMergeOfTheGuardedHalves) {
   // Half 0 holds a firefly at (7, 7), half 1 does not; both have two samples per pixel.
   const SubBuffer h0 = fromSamples(20, 20, [](int x, int y) {

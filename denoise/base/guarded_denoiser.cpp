@@ -26,8 +26,11 @@ Image GuardedDenoiser::run(const DenoiseInput& input) const {
   const int exponent = radianceScaleExponent(guarded.input);
   scaleColor(guarded.input, -exponent);
   Image out = inner_->run(guarded.input);
+  keepWithinTheSamples(out, guarded.input.whole, kSampleSigmas);
   finishOutput(out, guarded.input.whole.color.mean);
   scaleImage(out, exponent);
+  // The input as given: the guard may have spread an excess onto such a pixel.
+  keepNoiseFreeMisses(out, input.whole);
   return out;
 }
 
@@ -40,6 +43,41 @@ void finishOutput(Image& output, const Image& noisy) {
     const float value = std::isfinite(out[i]) ? out[i] : fallback;
     out[i] = std::max(value, std::min(0.0f, fallback));
   }
+}
+
+void keepWithinTheSamples(Image& output, const SubBuffer& whole, double sigmas) {
+  const Image& mean = whole.color.mean;
+  const Image& variance = whole.color.varianceOfMean;
+  if (!output.sameShape(mean)) throw std::invalid_argument("keepWithinTheSamples: shapes differ");
+  if (!whole.sampleCount.sameSize(mean)) return;
+  for (int y = 0; y < mean.height(); ++y)
+    for (int x = 0; x < mean.width(); ++x) {
+      if (!(whole.sampleCount(x, y, 0) >= kMinSamplesToBound)) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double m = mean(x, y, c), v = variance(x, y, c);
+        if (!(v > 0.0 && std::isfinite(v) && std::isfinite(m))) continue;
+        const double reach = sigmas * std::sqrt(v);
+        float& o = output(x, y, c);
+        if (std::isfinite(o)) o = float(std::clamp(double(o), m - reach, m + reach));
+      }
+    }
+}
+
+void keepNoiseFreeMisses(Image& output, const SubBuffer& whole) {
+  const Image& color = whole.color.mean;
+  if (!output.sameShape(color)) throw std::invalid_argument("keepNoiseFreeMisses: shapes differ");
+  const Image& depth = whole.depth.mean;
+  if (!depth.sameSize(color) || !whole.sampleCount.sameSize(color)) return;
+  for (int y = 0; y < color.height(); ++y)
+    for (int x = 0; x < color.width(); ++x) {
+      if (!(whole.sampleCount(x, y, 0) >= 2.0f) || depth(x, y, 0) != 0.0f) continue;
+      bool exact = true;
+      for (int c = 0; c < 3; ++c)
+        exact = exact && whole.color.varianceOfMean(x, y, c) == 0.0f &&
+                std::isfinite(color(x, y, c)) && color(x, y, c) >= 0.0f;
+      if (!exact) continue;
+      for (int c = 0; c < 3; ++c) output(x, y, c) = color(x, y, c);
+    }
 }
 
 }  // namespace chorus

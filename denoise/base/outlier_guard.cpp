@@ -84,6 +84,19 @@ PixelStats mergedAt(const SubBuffer& a, const SubBuffer& b, size_t i, int c) {
   return {mean, float(std::min(variance, double(kMaxFloat))), float(n)};
 }
 
+// How much a pixel at depth b shares the surface of an outlier at depth a: a Gaussian in their
+// relative difference (σ = kSpreadDepthSigma of the larger). A heavy tail belongs to what the
+// outlier's pixel sees; spread across a depth edge (onto the black background behind a lamp)
+// its energy became a glow where the reference is 0.
+constexpr double kSpreadDepthSigma = 0.1;
+double sameSurface(double a, double b) {
+  if (!std::isfinite(a) || !std::isfinite(b)) return a == b ? 1.0 : 0.0;
+  const double scale = kSpreadDepthSigma * std::max(std::abs(a), std::abs(b));
+  if (scale == 0.0) return 1.0;
+  const double d = (a - b) / scale;
+  return std::exp(-0.5 * d * d);
+}
+
 class PartGuard {
  public:
   PartGuard(const SubBuffer& part, const SubBuffer* other, const OutlierGuardOptions& options)
@@ -119,9 +132,13 @@ class PartGuard {
     const int x0 = std::max(0, e.x - r), x1 = std::min(w - 1, e.x + r);
     const int y0 = std::max(0, e.y - r), y1 = std::min(h - 1, e.y + r);
     const double falloff = 2.0 / (double(r) * double(r));  // 1 / (2 σ²), σ = r / 2
+    const Image& depth = part_.depth.mean;
+    const bool hasDepth = depth.sameSize(part_.color.mean);
+    const double here = hasDepth ? depth(e.x, e.y, 0) : 0.0;
     auto kernel = [&](int x, int y) {
       const double dx = x - e.x, dy = y - e.y;
-      return std::exp(-(dx * dx + dy * dy) * falloff);
+      return std::exp(-(dx * dx + dy * dy) * falloff) *
+             (hasDepth ? sameSurface(here, depth(x, y, 0)) : 1.0);
     };
     double total = 0;
     for (int y = y0; y <= y1; ++y)

@@ -18,7 +18,8 @@
 // becomes S's mean without its largest sample (see withoutLargestSample; L for a single
 // sample), kept within [min(0, L), T]; its variance of the mean min(v, max(σ_N², (x' − L)²)).
 // What it had above that is dropped when the outlier is alone, but spread over the
-// (2 spreadRadius + 1)² window around it (Gaussian weights, σ = spreadRadius / 2) when it has
+// (2 spreadRadius + 1)² window around it (Gaussian weights, σ = spreadRadius / 2, times a
+// Gaussian in the relative depth difference: the same surface only) when it has
 // peers: x − L ≤ peerSigmas × the RMS
 // deviation of the neighbours from L, i.e. a few neighbours deviate as much. Such outliers are
 // the samples of a heavy-tailed distribution that is really there (caustic paths): dropping

@@ -82,8 +82,22 @@ namespace chorus {
 
 enum class MseForm { PerChannel, Summed };
 
+// Which runs the estimate compares with which noisy means ("folds"):
+// - Halves: y^A with x^B and y^B with x^A (the paper's dual-buffer estimate): the error of a
+//   run on half the samples.
+// - Quarters: y^(−k), the run on every quarter but k, with x_k (k = 0 … 3; needs K = 4 and the
+//   held-out runs): the error of a run on 3/4 of the samples, closer to the full run's at a
+//   few samples per pixel, where members that split their own input (NFOR, RDFC) are much
+//   better on the full buffer than on a half. Unbiased for the same reason: y^(−k) does not
+//   see quarter k.
+// - Extrapolated: 1.5 × the quarters' estimate − 0.5 × the halves' (an error that falls as
+//   a + b/s with the share s of the samples, extrapolated from s = ½ and ¾ to 1). Not unbiased
+//   for any run's error; may be indefinite (the solver then finds a feasible local minimiser).
+enum class MseEstimate { Halves, Quarters, Extrapolated };
+
 struct MseOptions {
   MseForm form = MseForm::Summed;
+  MseEstimate estimate = MseEstimate::Halves;
   int windowRadius = 5;
   bool relative = false;
   double outlierCap = 30.0;
@@ -91,6 +105,7 @@ struct MseOptions {
   double plausibility = 4.0;
   double imagePrior = 0.3;
   double noisyFallback = 10.0;
+  double memberFallback = 0.0;
   float windowSigmaSpatial = 0;  // σ_s in pixels; 0 = the window radius
   float windowSigmaNormal = 0.2f;
   float windowSigmaAlbedo = 0.1f;
@@ -159,6 +174,12 @@ class MseEstimator {
   // K²·(½ Σ_c (x^A − x^B)² + Σ_c (0.1·(mean |x| + |x̄|))²): every base is far from both noisy
   // halves, which agree (see noisyFallback).
   bool noBasePlausible(size_t pixel) const;
+  // memberFallback K (0 = off, else ≥ 1): per pixel, the base to use instead of the blend of
+  // `weights` (one map per base, 1 or 3 channels), or −1 to keep the blend. Where the blend's
+  // own error term d_z = mean over the folds of Σ_c (z^f − x_f)², z^f = Σ_i w_i y_i^f, exceeds
+  // K²·(min_i d_i + the comparators' noise + the 10 % floor), the base with the least d_i is
+  // used: a safeguard that chooses between the blend and a member, never the noisy value.
+  std::vector<int> memberFallbacks(std::span<const Image> weights) const;
 
  private:
   MseEstimator(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,
@@ -174,20 +195,35 @@ class MseEstimator {
   std::vector<double> imagePriorTerms() const;
   // H += imagePrior · (tangent trace of H) · imagePrior_, per pixel of `rows`.
   void addImagePrior(MseRows& rows) const;
-  // Per base of a mask at a pixel: each half's own error term, tA_i = Σ_c (y_i^A − x^B)² and
-  // tB_i = Σ_c (y_i^B − x^A)², and the allowances the tests compare them with.
-  struct HalfTerms {
-    std::array<double, kMaxDenoisers> a{}, b{};
-    double floorA = 0, floorB = 0, floorMean = 0;  // Σ_c (0.1 (mean |x| + |x|))² of x^A, x^B, x̄
-    double halvesApart = 0;                        // ½ Σ_c (x^A − x^B)²
-    double mean(int i) const { return 0.5 * (a[size_t(i)] + b[size_t(i)]); }  // d_i
-    struct Least {
-      double a, b, mean;
-    };
-    Least least(BaseMask mask, int baseCount) const;  // least tA, tB and d over `mask`
+  // One fold of the estimate: every base's run that did not see `comparator`, the noisy mean
+  // it is compared with (halves: y^A with x^B, y^B with x^A; quarters: y^(−k) with x_k).
+  struct Fold {
+    std::array<const float*, kMaxDenoisers> out{};
+    const float* comparator = nullptr;
   };
-  HalfTerms halfTermsAt(size_t pixel, BaseMask mask) const;
-  // The solver's mask and the fallback flag at a pixel, from one evaluation of the half terms.
+  static constexpr int kMaxFolds = 4;
+  bool comparatorsFinite(size_t pixel) const;
+  // The estimated variance of a comparator at one value index (pixel·3 + channel), averaged
+  // over the folds: ½(x^A − x^B)² for the halves.
+  double comparatorNoise(size_t valueIndex) const;
+  static double comparatorNoise(const std::vector<Fold>& folds, size_t valueIndex);
+  // Per base of a mask at a pixel: each fold's own error term t_f,i = Σ_c (y_i^f − x_f)², and
+  // the allowances the tests compare them with.
+  struct FoldTerms {
+    int folds = 0;
+    std::array<std::array<double, kMaxDenoisers>, kMaxFolds> t{};
+    std::array<double, kMaxFolds> floor{};  // Σ_c (0.1 (mean |x| + |x_f|))² per comparator
+    double floorMean = 0;                   // the same of the comparators' mean
+    double noise = 0;                       // Σ_c comparatorNoise (½ Σ_c (x^A − x^B)²)
+    double mean(int i) const;               // d_i: the mean over the folds
+    struct Least {
+      std::array<double, kMaxFolds> fold;
+      double mean;
+    };
+    Least least(BaseMask mask, int baseCount) const;  // least t_f and d over `mask`
+  };
+  FoldTerms foldTermsAt(size_t pixel, BaseMask mask) const;
+  // The solver's mask and the fallback flag at a pixel, from one evaluation of the fold terms.
   struct PixelMasks {
     BaseMask solvable = 0;
     bool noisyFallback = false;
@@ -195,16 +231,17 @@ class MseEstimator {
   PixelMasks masksAt(size_t pixel) const;
   // The bases of `mask` that pass the consistency test / the plausibility test at a pixel.
   BaseMask consistentBases(size_t pixel, BaseMask mask) const;
-  BaseMask plausibleBases(BaseMask mask, const HalfTerms& terms) const;
+  BaseMask plausibleBases(BaseMask mask, const FoldTerms& terms) const;
   int planeCount() const { return groups() * (entries() + 1); }
   int entries() const { return baseCount_ * (baseCount_ + 1) / 2; }
 
   MseOptions options_;
   int width_ = 0, height_ = 0, baseCount_ = 0;
   double scale_ = 1.0;  // absolute form: values are divided by scale² (scale = mean |x|)
-  std::array<const float*, kMaxDenoisers> outA_{}, outB_{}, outFull_{};
-  const float* colorA_ = nullptr;
-  const float* colorB_ = nullptr;
+  std::array<const float*, kMaxDenoisers> outFull_{};
+  std::vector<Fold> folds_;           // the tests' folds and the estimate's (weight primary)
+  std::vector<Fold> secondaryFolds_;  // Extrapolated: the halves (weight secondary)
+  double primaryWeight_ = 1.0, secondaryWeight_ = 0.0;
   const float* reference_ = nullptr;  // oracle only
   std::vector<double> imagePrior_;    // imagePriorTerms() (empty: no prior)
   PlanarGuides windowGuides_;

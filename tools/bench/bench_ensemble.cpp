@@ -135,7 +135,8 @@ int main(int argc, char** argv) {
     bases.push_back({"box" + std::to_string(radii[i]) + (clamps[i] > 0 ? "clamped" : ""),
                      boxBlur(guides.colorA, radii[i], clamps[i]),
                      boxBlur(guides.colorB, radii[i], clamps[i]),
-                     boxBlur(guides.color, radii[i], clamps[i])});
+                     boxBlur(guides.color, radii[i], clamps[i]),
+                     {}});
   const auto pointers = pointersTo(bases);
   const double megapixels = double(size) * size / 1e6;
 

@@ -124,7 +124,7 @@ MemberRuns runAlone(ReadInput& input, const std::vector<std::string>& specs) {
   }
   std::vector<Image> images = runMembersAlone(full, members, &runs.times);
   for (size_t m = 0; m < members.size(); ++m)
-    runs.bases.push_back({members[m].label, {}, {}, std::move(images[m])});
+    runs.bases.push_back({members[m].label, {}, {}, std::move(images[m]), {}});
   return runs;
 }
 

@@ -15,6 +15,11 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
   cmd.add_option("--mse", mseForm,
                  "MSE matrix per-channel (one weight per colour channel) or summed (one per pixel)")
       ->capture_default_str();
+  cmd.add_option("--estimate", estimate,
+                 "What the MSE estimate compares: halves (each member's runs on half A and B with "
+                 "the other half) or quarters (its runs on three quarters with the fourth: "
+                 "4 more runs per member, needs 4 sub-buffers)")
+      ->capture_default_str();
   cmd.add_option("--window", window,
                  "Radius of the feature-guided window the MSE estimate is accumulated over "
                  "(0 = per pixel, as in the paper)")
@@ -45,6 +50,10 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
                  "the noisy halves' difference (+10%): every base is far from both halves "
                  "(0 = off, else at least 1)")
       ->capture_default_str();
+  cmd.add_option("--member-fallback", memberFallback,
+                 "Use the member closest to the noisy data where the blend's own error term "
+                 "exceeds K² times that member's plus the noise (0 = off, else at least 1)")
+      ->capture_default_str();
   cmd.add_option("--solver-seed", seed, "Seed of the pairwise solver")->capture_default_str();
 }
 
@@ -57,6 +66,14 @@ CombineOptions EnsembleFlags::options() const {
     o.mse.form = MseForm::Summed;
   else
     throw Error("unknown --mse '" + mseForm + "' (known: per-channel, summed)");
+  if (estimate == "halves")
+    o.mse.estimate = MseEstimate::Halves;
+  else if (estimate == "quarters")
+    o.mse.estimate = MseEstimate::Quarters;
+  else if (estimate == "extrapolated")
+    o.mse.estimate = MseEstimate::Extrapolated;
+  else
+    throw Error("unknown --estimate '" + estimate + "' (known: halves, quarters, extrapolated)");
   if (window < 0) throw Error("--window must be at least 0");
   o.mse.windowRadius = window;
   o.mse.relative = relative;
@@ -72,6 +89,9 @@ CombineOptions EnsembleFlags::options() const {
   if (!(noisyFallback == 0 || noisyFallback >= 1))
     throw Error("--noisy-fallback must be 0 (off) or at least 1");
   o.mse.noisyFallback = noisyFallback;
+  if (!(memberFallback == 0 || memberFallback >= 1))
+    throw Error("--member-fallback must be 0 (off) or at least 1");
+  o.mse.memberFallback = memberFallback;
   if (weightFilter != "bilateral" && weightFilter != "none")
     throw Error("unknown --weight-filter '" + weightFilter + "' (known: bilateral, none)");
   o.filter.enabled = weightFilter == "bilateral";

@@ -12,6 +12,13 @@ namespace chorus {
 void writeAtomically(const std::filesystem::path& target,
                      const std::function<void(const std::filesystem::path&)>& write);
 
+// Whether `name` is one of writeAtomically's temporary files ("<target>.tmp<pid>_<n>").
+bool isTemporaryFileName(const std::string& name);
+
+// Removes the temporary files a killed writer left in `dir` (and, if `recursive`, below it);
+// only for a directory no other process writes (owned_directory.h). Returns how many.
+int removeTemporaryFiles(const std::filesystem::path& dir, bool recursive);
+
 // Convenience for text outputs (JSON, CSV, HTML).
 void writeTextAtomically(const std::filesystem::path& target, const std::string& text);
 

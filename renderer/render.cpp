@@ -36,17 +36,21 @@ void validate(const RenderOptions& o) {
 
 }  // namespace
 
+Resolution renderResolution(const Scene& scene, const RenderOptions& options) {
+  // The camera's own aspect decides a missing dimension; the framing camera adapts to the image.
+  const std::vector<CameraDesc>& cameras = scene.data().cameras;
+  const CameraDesc* fileCamera = options.camera >= 0 && size_t(options.camera) < cameras.size()
+                                     ? &cameras[size_t(options.camera)]
+                                     : nullptr;
+  return chooseResolution(fileCamera ? *fileCamera : CameraDesc{}, options.width, options.height);
+}
+
 RenderResult render(const Scene& scene, const RenderOptions& options,
                     const ProgressCallback& progress) {
   validate(options);
   const Stopwatch elapsed;
 
-  // The camera's own aspect decides a missing dimension; the framing camera adapts to the image.
-  const std::vector<CameraDesc>& cameras = scene.data().cameras;
-  const CameraDesc* fileCamera =
-      size_t(options.camera) < cameras.size() ? &cameras[size_t(options.camera)] : nullptr;
-  const Resolution resolution =
-      chooseResolution(fileCamera ? *fileCamera : CameraDesc{}, options.width, options.height);
+  const Resolution resolution = renderResolution(scene, options);
   const Camera camera(
       selectCamera(scene, options.camera, float(resolution.width) / float(resolution.height)),
       resolution);

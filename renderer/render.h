@@ -16,6 +16,7 @@
 #include <functional>
 
 #include "denoise/buffers/sample_buffers.h"
+#include "renderer/integrator/camera.h"
 #include "renderer/scene/scene.h"
 
 namespace chorus::render {
@@ -65,6 +66,10 @@ struct RenderResult {
   SampleBuffers buffers;
   RenderStats stats;
 };
+
+// The image size render() gives `options` on `scene` (the width and height given, the rest from
+// the camera's aspect), for checks before rendering: memory, the size of a reference.
+Resolution renderResolution(const Scene& scene, const RenderOptions& options);
 
 // Throws chorus::Error for invalid options (spp < 1, splits not 1/2/4, a missing camera, …).
 RenderResult render(const Scene& scene, const RenderOptions& options,

@@ -4,11 +4,14 @@
     python3 scenes/generate_scenes.py [OUTPUT_DIR]     # default: the folder of this script
 
 A development tool: the committed .gltf/.bin/.png files are what chorus uses; this script keeps
-their geometry reproducible and reviewable. Scenes (see README.md):
+their geometry reproducible and reviewable. Scenes (see scenes/README.md):
   cornell-box.gltf       the default scene: the classic Cornell room, one emissive quad light
   glass-and-metal.gltf   glass sphere (transmission + volume), smooth and rough metal spheres,
                          checker floor (embedded PNG), one small bright emissive light
   punctual-lights.gltf   spot + point light (KHR_lights_punctual), brick floor with a normal map
+  stiff-caustics.gltf    a tiny, very bright emitter inside a glass ball and a solid glass sphere
+                         under a dim area light: light reaches the room through glass only, by
+                         rare caustic paths (fireflies thousands of times the mean)
 """
 import base64
 import json
@@ -541,11 +544,71 @@ def punctual_lights(directory):
     gltf.write(directory, embed_buffer=False)
 
 
+# ---------------------------------------------------------------------------------------------
+# Scene 4: stiff caustics
+#
+# The stiff case of denoising: an 8 cm emitter of radiance 600 sealed inside a solid glass ball.
+# Shadow rays do not pass glass, so everything it lights is found by BSDF sampling alone: a
+# diffuse bounce that happens to refract through the ball onto the emitter, a sample thousands
+# of times the pixel's mean. A large dim ceiling light gives the smooth part of the image (and
+# its own caustic under the second, clear glass sphere).
+
+
+def stiff_caustics(directory):
+    gltf = Gltf("stiff-caustics")
+    floor_material = lambertian(gltf, "floor", (0.7, 0.68, 0.64))
+    wall_material = lambertian(gltf, "wall", (0.55, 0.6, 0.7))
+    glass = gltf.material("glass", (1.0, 1.0, 1.0), 0.0, 0.0, {
+        "KHR_materials_transmission": {"transmissionFactor": 1.0},
+        "KHR_materials_ior": {"ior": 1.5}})
+    gold = gltf.material("rough gold", (1.0, 0.78, 0.34), 1.0, 0.25)
+    ember = gltf.material("ember", (0.0, 0.0, 0.0), 0.0, 1.0,
+                          {"KHR_materials_specular": {"specularFactor": 0.0},
+                           "KHR_materials_emissive_strength": {"emissiveStrength": 600.0}},
+                          emissiveFactor=[1.0, 0.8, 0.55])
+    fill = gltf.material("ceiling light", (0.0, 0.0, 0.0), 0.0, 1.0,
+                         {"KHR_materials_specular": {"specularFactor": 0.0},
+                          "KHR_materials_emissive_strength": {"emissiveStrength": 3.0}},
+                         emissiveFactor=[0.9, 0.95, 1.0])
+
+    floor = Mesh()
+    floor.quad([[-3, 0, 3], [3, 0, 3], [3, 0, -3], [-3, 0, -3]], [0, 1, 0])
+    gltf.node("floor", mesh=gltf.mesh("floor", [(gltf.geometry(floor), floor_material)]))
+    wall = Mesh()
+    wall.quad([[-3, 0, -1.5], [3, 0, -1.5], [3, 3, -1.5], [-3, 3, -1.5]], [0, 0, 1])
+    gltf.node("back wall", mesh=gltf.mesh("back wall", [(gltf.geometry(wall), wall_material)]))
+    ceiling = Mesh()
+    ceiling.quad([[-1, 3, -1], [1, 3, -1], [1, 3, 1], [-1, 3, 1]], [0, -1, 0])
+    gltf.node("ceiling light", mesh=gltf.mesh("ceiling light",
+                                              [(gltf.geometry(ceiling), fill)]))
+
+    ball = 0.28
+    gltf.node("glass ball", mesh=gltf.mesh("glass ball", [(gltf.geometry(uv_sphere(ball, 48, 24)),
+                                                            glass)]),
+              translation=[-0.45, ball, 0.0])
+    gltf.node("ember", mesh=gltf.mesh("ember", [(gltf.geometry(uv_sphere(0.04, 16, 8)), ember)]),
+              translation=[-0.45, ball, 0.0])
+    sphere = 0.3
+    gltf.node("clear sphere", mesh=gltf.mesh("clear sphere",
+                                             [(gltf.geometry(uv_sphere(sphere, 48, 24)), glass)]),
+              translation=[0.5, sphere, 0.35])
+    gltf.node("gold sphere", mesh=gltf.mesh("gold sphere",
+                                            [(gltf.geometry(uv_sphere(0.22, 32, 16)), gold)]),
+              translation=[0.35, 0.22, -0.7])
+
+    eye = [0.0, 0.95, 1.9]
+    camera = gltf.camera("camera", math.radians(40.0), 1.0)
+    gltf.node("camera", camera=camera, translation=eye,
+              rotation=look_at_rotation(eye, [0.0, 0.25, -0.15]))
+    gltf.write(directory, embed_buffer=True)
+
+
 def main():
     directory = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
     cornell_box(directory)
     glass_and_metal(directory)
     punctual_lights(directory)
+    stiff_caustics(directory)
 
 
 if __name__ == "__main__":

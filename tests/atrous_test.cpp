@@ -15,7 +15,8 @@
 namespace chorus {
 namespace {
 
-// Documented in README.md (à-trous): measured relMSE 0.053 → 0.0054 (9.8×) at 64×64, 16 spp.
+// Documented in docs/members/sbf-atrous-bilateral.md (à-trous): measured relMSE 0.053 → 0.0054
+// (9.8×) at 64×64, 16 spp.
 constexpr double kMinImprovement = 5.0;
 
 TEST(Atrous, ReducesRelMseOnTheSyntheticScene) {
@@ -23,7 +24,8 @@ TEST(Atrous, ReducesRelMseOnTheSyntheticScene) {
 }
 
 TEST(Atrous, DemodulationHelpsOnTheTexturedScene) {
-  // The default (demodulate = true) was chosen by this measurement; see README.md.
+  // The default (demodulate = true) was chosen by this measurement; see
+  // docs/members/sbf-atrous-bilateral.md.
   const test::SyntheticScene scene = test::syntheticScene(64);
   AtrousParams plain;
   plain.demodulate = false;

@@ -230,9 +230,41 @@ TEST(AuthoredScenes, PunctualLights) {
   EXPECT_GT(meanZ, 0.9);
 }
 
+TEST(AuthoredScenes, StiffCaustics) {
+  const tinygltf::Model model = load("stiff-caustics.gltf");
+  EXPECT_EQ(extensionsUsed(model),
+            (std::set<std::string>{"KHR_materials_emissive_strength", "KHR_materials_ior",
+                                   "KHR_materials_specular", "KHR_materials_transmission"}));
+  expectConsistentBuffers(model);
+  EXPECT_EQ(model.buffers[0].uri.rfind("data:", 0), 0u);
+  const auto& glass = material(model, "glass");
+  EXPECT_EQ(extensionNumber(glass, "KHR_materials_transmission", "transmissionFactor"), 1.0);
+  EXPECT_EQ(extensionNumber(glass, "KHR_materials_ior", "ior"), 1.5);
+  // The ember is far brighter than the ceiling light and sealed inside the glass ball: same
+  // centre, its radius well inside the ball's.
+  const double ember = extensionNumber(material(model, "ember"), "KHR_materials_emissive_strength",
+                                       "emissiveStrength");
+  const double fill = extensionNumber(material(model, "ceiling light"),
+                                      "KHR_materials_emissive_strength", "emissiveStrength");
+  EXPECT_GT(ember, 100 * fill);
+  const auto& ballNode = node(model, "glass ball");
+  const auto& emberNode = node(model, "ember");
+  for (int i = 0; i < 3; ++i)
+    EXPECT_EQ(ballNode.translation[size_t(i)], emberNode.translation[size_t(i)]);
+  auto radius = [&](const tinygltf::Node& n) {
+    const auto& prim = model.meshes[size_t(n.mesh)].primitives[0];
+    return model.accessors[size_t(prim.attributes.at("POSITION"))].maxValues[1];
+  };
+  EXPECT_LT(radius(emberNode), 0.25 * radius(ballNode));
+  EXPECT_NEAR(ballNode.translation[1], radius(ballNode), 1e-6);  // resting on the floor
+  ASSERT_EQ(model.cameras.size(), 1u);
+  EXPECT_LT(cameraForward(node(model, "camera"))[2], -0.8);
+}
+
 TEST(AuthoredScenes, EachSceneIsSmall) {
   // Every file a scene needs stays under 200 KB in total.
-  for (const char* scene : {"cornell-box", "glass-and-metal", "punctual-lights"}) {
+  for (const char* scene :
+       {"cornell-box", "glass-and-metal", "punctual-lights", "stiff-caustics"}) {
     uintmax_t bytes = 0;
     for (const auto& entry : fs::directory_iterator(chorus::test::sourceDir() / "scenes"))
       if (entry.path().filename().string().rfind(scene, 0) == 0) bytes += entry.file_size();

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <limits>
 
 #include "common/image/exr_io.h"
 #include "tests/support/test_support.h"
@@ -70,6 +71,23 @@ TEST_F(CompareCli, ErrorsNameTheFile) {
   expectOneLineError(runChorus({"compare", (dir / "img.exr").string(), (dir / "ref.exr").string(),
                                 "--layer", "nope"}),
                      "nope");
+}
+
+// One NaN would make every metric NaN (printed as null, exit 0 before): the file is refused
+// instead, with the count and place of its non-finite pixels.
+TEST_F(CompareCli, NonFinitePixelsAreRefusedNamingTheFile) {
+  Image image(16, 12, 3, 0.6f);
+  image(3, 2, 1) = std::numeric_limits<float>::quiet_NaN();
+  writeExr(dir / "nan.exr", image);
+  expectOneLineError(
+      runChorus({"compare", (dir / "nan.exr").string(), (dir / "ref.exr").string(), "--json"}),
+      "nan.exr: 1 pixel(s) are NaN or infinite (the first at x 3, y 2)");
+  Image reference(16, 12, 3, 0.5f);
+  reference(15, 11, 0) = std::numeric_limits<float>::infinity();
+  reference(0, 5, 2) = -std::numeric_limits<float>::infinity();
+  writeExr(dir / "inf.exr", reference);
+  expectOneLineError(runChorus({"compare", (dir / "img.exr").string(), (dir / "inf.exr").string()}),
+                     "inf.exr: 2 pixel(s) are NaN or infinite (the first at x 0, y 5)");
 }
 
 TEST(Cli, HelpAndVersion) {

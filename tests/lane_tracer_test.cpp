@@ -160,8 +160,9 @@ TEST(LaneTracer, AutomaticChoiceFollowsTheUntexturedAreaShare) {
     b.addQuad({0, 0, 0}, {u, 0, 0}, {u, u, 0}, {0, u, 0},
               b.addMaterial({{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}}));
     const int texture = b.addTexture(1, 1, {200, 100, 50, 255});
-    b.addQuad({0, 0, 1}, {t, 0, 1}, {t, t, 1}, {0, t, 1},
-              b.addMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", texture}}}}}}));
+    b.addQuad(
+        {0, 0, 1}, {t, 0, 1}, {t, t, 1}, {0, t, 1},
+        b.addMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", texture}}}}}}));
     const int cam =
         b.addCamera({{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", 0.01}}}});
     b.addNode({{"camera", cam}, {"translation", {1, 1, 5}}});

@@ -15,7 +15,8 @@
 namespace chorus {
 namespace {
 
-// Documented in README.md (RDFC): measured relMSE 0.053 → 0.0032 (17×) at 64×64, 16 spp.
+// Documented in docs/members/rdfc-jnlm.md (RDFC): measured relMSE 0.053 → 0.0032 (17×) at 64×64, 16
+// spp.
 constexpr double kMinImprovement = 8.0;
 
 TEST(Rdfc, ReducesRelMseOnTheSyntheticScene) {

@@ -61,7 +61,8 @@ TEST(TungstenDir, ReadsThePeerData) {
   EXPECT_EQ(in.width(), 256);
   EXPECT_EQ(in.height(), 256);
   EXPECT_EQ(in.whole.sampleCount.at(0, 0, 0), 4.0f);
-  // The README counts 18265 NaN pixels in visibilityVariance.exr for this case.
+  // ../shared/peers/tungsten-nfor/README.md counts 18265 NaN pixels in visibilityVariance.exr for
+  // this case.
   int nanPixels = 0;
   for (float v : in.whole.visibility.varianceOfMean.values()) nanPixels += std::isnan(v);
   EXPECT_EQ(nanPixels, 18265);

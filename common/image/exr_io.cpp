@@ -16,6 +16,8 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/image/image_limits.h"
+#include "common/regular_file.h"
 
 namespace chorus {
 namespace fs = std::filesystem;
@@ -24,11 +26,15 @@ namespace {
 
 // OpenEXR compresses and decompresses blocks of lines on its own thread pool, which is empty
 // until sized: writing a 512², K = 4 render.exr took 1.6 s on one thread. Sized once, to the
-// machine.
+// machine. Also once: the largest image and tile sizes OpenEXR opens, so that a header claiming
+// 2^31 rows is refused before OpenEXR allocates its tables for them (tiles beyond 8192² exist
+// in no real file).
 int exrThreads() {
   static const int threads = [] {
     const int n = int(std::max(1u, std::thread::hardware_concurrency()));
     Imf::setGlobalThreadCount(n);
+    Imf::Header::setMaxImageSize(int(kMaxImagePixels), int(kMaxImagePixels));
+    Imf::Header::setMaxTileSize(8192, 8192);
     return n;
   }();
   return threads;
@@ -71,9 +77,7 @@ int suffixRank(const std::string& suffix) {
 }
 
 void checkIsExr(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw fileError(path, "no such file");
-  if (fs::is_directory(path, ec)) throw fileError(path, "is a directory, not an EXR file");
+  requireRegularFile(path);
   std::ifstream in(path, std::ios::binary);
   unsigned char magic[4] = {0, 0, 0, 0};
   in.read(reinterpret_cast<char*>(magic), 4);
@@ -148,9 +152,15 @@ std::vector<ExrLayer> readExr(const fs::path& path) {
   try {
     Imf::InputFile file(path.c_str(), exrThreads());
     const Imath::Box2i window = file.header().dataWindow();
-    const int width = window.max.x - window.min.x + 1;
-    const int height = window.max.y - window.min.y + 1;
+    // 64-bit: a data window from INT_MIN to INT_MAX is 2^32 wide.
+    const int64_t width = int64_t(window.max.x) - int64_t(window.min.x) + 1;
+    const int64_t height = int64_t(window.max.y) - int64_t(window.min.y) + 1;
+    int64_t channelCount = 0;
+    for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it)
+      ++channelCount;
     if (width <= 0 || height <= 0) throw fileError(path, "empty data window");
+    if (const std::string problem = imageSizeProblem(width, height, channelCount); !problem.empty())
+      throw fileError(path, problem);
 
     // Group channels into layers by the part before the last dot.
     std::vector<std::string> layerOrder;
@@ -181,17 +191,14 @@ std::vector<ExrLayer> readExr(const fs::path& path) {
         const int ra = suffixRank(a), rb = suffixRank(b);
         return ra != rb ? ra < rb : a < b;
       });
-      layers.push_back({layerName, Image(width, height, int(names.size()))});
+      layers.push_back({layerName, Image(int(width), int(height), int(names.size()))});
       Image& image = layers.back().image;
       const size_t pixelStride = sizeof(float) * size_t(image.channels());
-      for (size_t c = 0; c < names.size(); ++c) {
-        // Slice base is offset so that the data window's corner lands on pixel (0, 0).
-        char* origin = reinterpret_cast<char*>(image.data() + c) -
-                       ptrdiff_t(window.min.x) * ptrdiff_t(pixelStride) -
-                       ptrdiff_t(window.min.y) * ptrdiff_t(pixelStride) * width;
+      // Slice::Make places the data window's corner on pixel (0, 0).
+      for (size_t c = 0; c < names.size(); ++c)
         frame.insert(channelName(layerName, names[c]),
-                     Imf::Slice(Imf::FLOAT, origin, pixelStride, pixelStride * size_t(width)));
-      }
+                     Imf::Slice::Make(Imf::FLOAT, image.data() + c, window, pixelStride,
+                                      pixelStride * size_t(width)));
     }
     file.setFrameBuffer(frame);
     file.readPixels(window.min.y, window.max.y);

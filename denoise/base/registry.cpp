@@ -5,6 +5,7 @@
 #include "denoise/base/atrous/atrous.h"
 #include "denoise/base/cross_bilateral/bilateral.h"
 #include "denoise/base/cross_bilateral/sbf.h"
+#include "denoise/base/guarded_denoiser.h"
 #include "denoise/base/jnlm/joint_nlmeans.h"
 #include "denoise/base/nfor/nfor.h"
 #include "denoise/base/nlm/dual_buffer_nlm.h"
@@ -58,7 +59,11 @@ std::unique_ptr<BaseDenoiser> createDenoiser(const std::string& spec) {
         colon == std::string::npos ? ParamMap() : ParamMap::parse(spec.substr(colon + 1), name);
     std::unique_ptr<BaseDenoiser> denoiser;
     try {
-      denoiser = entry.create(params);
+      OutlierGuardOptions guard;
+      guard.ceilingSigmas = params.getFloat("guard", guard.ceilingSigmas);
+      if (!(guard.ceilingSigmas >= 0.0f))
+        throw Error("guard must be 0 (off) or a positive number of standard deviations");
+      denoiser = std::make_unique<GuardedDenoiser>(entry.create(params), guard);
     } catch (const Error& e) {  // a bad value: say which denoiser it was for
       throw Error("denoiser " + name + ": " + e.what());
     }

@@ -21,8 +21,10 @@ struct DenoiserEntry {
 // Every built-in denoiser, in a fixed order.
 const std::vector<DenoiserEntry>& builtinDenoisers();
 
-// Builds a denoiser from a spec such as "nfor" or "jnlm:k=0.4". Throws chorus::Error for an
-// unknown name (listing the known ones) or an unknown parameter.
+// Builds a denoiser from a spec such as "nfor" or "jnlm:k=0.4", inside a GuardedDenoiser
+// (guarded_denoiser.h); every spec also takes guard=S, the outlier guard's ceiling in standard
+// deviations (outlier_guard.h, default 8; 0 = no guard). Throws chorus::Error for an unknown
+// name (listing the known ones) or an unknown parameter.
 std::unique_ptr<BaseDenoiser> createDenoiser(const std::string& spec);
 
 // Splits "a,b:k=1,c" into specs; throws chorus::Error on an empty list or empty item.

@@ -3,10 +3,15 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
 namespace chorus {
+namespace {
+constexpr double kMaxFloat = std::numeric_limits<float>::max();
+}  // namespace
 
 int channelCount(Quantity q) {
   return (q == Quantity::Depth || q == Quantity::Visibility) ? 1 : 3;
@@ -139,7 +144,8 @@ SubBuffer merge(const std::vector<const SubBuffer*>& parts) {
         for (size_t c = 0; c < channels; ++c) {
           const size_t e = i * channels + c;
           outMean[e] = float(mean[e]);
-          outVariance[e] = float(m2[e] * varianceScale[i]);
+          // Clamped: the square of a finite radiance above ~1.8e19 is not a finite float.
+          outVariance[e] = float(std::min(m2[e] * varianceScale[i], kMaxFloat));
         }
     }
   });

@@ -2,10 +2,14 @@
 
 #include <nlohmann/json.hpp>
 
-#include <fstream>
+#include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "common/error.h"
 #include "common/image/exr_io.h"
+#include "common/json_nesting.h"
+#include "common/regular_file.h"
 
 namespace chorus {
 namespace fs = std::filesystem;
@@ -31,16 +35,38 @@ Image readBuffer(const fs::path& file, int channels, int width, int height) {
   return image;
 }
 
+// Sample counts are stored as float images: whole numbers are exact up to 2^24, far beyond any
+// render's samples per pixel.
+constexpr double kMaxSpp = double(1 << 24);
+// meta.json is a few hundred bytes of flat JSON; the limits only keep a hostile one bounded.
+constexpr uint64_t kMaxMetaBytes = 1 << 20;
+constexpr int kMaxMetaNesting = 32;
+
+// meta.json's "spp" (0 when the file or the key is absent: unknown).
 float sppFromMeta(const fs::path& dir) {
   const fs::path meta = dir / "meta.json";
-  if (!fs::is_regular_file(meta)) return 0.0f;
+  std::error_code ec;
+  if (!fs::exists(meta, ec)) return 0.0f;
+  const std::vector<unsigned char> bytes = readRegularFile(meta, kMaxMetaBytes);
+  if (jsonNestsDeeperThan(bytes, kMaxMetaNesting))
+    throw fileError(meta,
+                    "nests JSON more than " + std::to_string(kMaxMetaNesting) + " levels deep");
+  nlohmann::json j;
   try {
-    std::ifstream in(meta);
-    const auto j = nlohmann::json::parse(in);
-    return j.contains("spp") ? j.at("spp").get<float>() : 0.0f;
+    j = nlohmann::json::parse(bytes.begin(), bytes.end());
   } catch (const std::exception& e) {
-    throw fileError(meta, std::string("cannot parse: ") + e.what());
+    std::string what = e.what();
+    if (const size_t nl = what.find('\n'); nl != std::string::npos) what.resize(nl);
+    throw fileError(meta, "cannot parse: " + what);
   }
+  if (!j.is_object() || !j.contains("spp")) return 0.0f;
+  const nlohmann::json& value = j.at("spp");
+  const double spp = value.is_number() ? value.get<double>() : -1.0;
+  if (!(spp >= 1 && spp <= kMaxSpp && spp == std::floor(spp)))
+    throw fileError(meta, "\"spp\" is " + value.dump().substr(0, 40) +
+                              ", not a whole number of samples from 1 to " +
+                              std::to_string(int64_t(kMaxSpp)));
+  return float(spp);
 }
 
 }  // namespace

@@ -17,7 +17,8 @@ bool isTungstenDirectory(const std::filesystem::path& dir);
 // whole = T / TVariance; halves = TA / TB. Tungsten does not store per-half variances: each
 // half's variance of the mean is taken as 2 × TVariance (equal sample counts), which is what
 // Tungsten's NFOR assumes too. Sample counts come from meta.json's "spp" when present
-// (whole = spp, halves = spp / 2), otherwise they are 0 ("unknown"). Missing feature files are
+// (whole = spp, halves = spp / 2; anything but a whole number from 1 to 2^24 is an error),
+// otherwise they are 0 ("unknown"). Missing feature files are
 // errors; files of a different size are errors naming the file.
 DenoiseInput readTungstenDirectory(const std::filesystem::path& dir);
 

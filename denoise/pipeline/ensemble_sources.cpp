@@ -1,6 +1,7 @@
 #include "denoise/pipeline/ensemble_sources.h"
 
 #include "common/error.h"
+#include "denoise/base/outlier_guard.h"
 
 namespace chorus {
 namespace {
@@ -52,8 +53,10 @@ EnsembleSources sourcesFromHalves(const DenoiseInput& input) {
 EnsembleGuides guidesFromSources(const EnsembleSources& sources) {
   EnsembleGuides guides;
   guides.color = sources.full.whole.color.mean;
-  guides.colorA = sources.a.whole.color.mean;
-  guides.colorB = sources.b.whole.color.mean;
+  // The halves the error estimate compares the members with, as the members saw them: with the
+  // outlier guard's clamps. A firefly left in x^B would dominate every (y^A − x^B)² around it.
+  guides.colorA = guardOutliers(sources.a).input.whole.color.mean;
+  guides.colorB = guardOutliers(sources.b).input.whole.color.mean;
   guides.albedo = sources.full.whole.albedo.mean;
   guides.normal = sources.full.whole.normal.mean;
   return guides;

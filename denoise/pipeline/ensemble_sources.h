@@ -29,7 +29,8 @@ EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull);
 // (without halves of their own), full = the input. Throws chorus::Error without halves.
 EnsembleSources sourcesFromHalves(const DenoiseInput& input);
 
-// The noisy colour of the full buffer and both halves, and the full buffer's albedo and normal.
+// The noisy colour of the full buffer, both halves (through the outlier guard, as the members
+// see them: denoise/base/outlier_guard.h), and the full buffer's albedo and normal.
 EnsembleGuides guidesFromSources(const EnsembleSources& sources);
 
 }  // namespace chorus

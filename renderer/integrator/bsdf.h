@@ -22,8 +22,8 @@
 //   - sample() of a non-delta lobe returns the value and pdf of all non-delta lobes together
 //     for that direction (equal to f(wo, wi) and pdf(wo, wi)), so MIS weights use pdf().
 //
-// Layering (see README "BSDF"): the diffuse base receives exactly the energy the GGX specular
-// layer does not reflect, via albedo scaling with the layer's directional albedo E(μ):
+// Layering (see docs/renderer.md, BSDF): the diffuse base receives exactly the energy the GGX
+// specular layer does not reflect, via albedo scaling with the layer's directional albedo E(μ):
 //   f_diffuse = baseColor/π · (1 − E(μo)) (1 − E(μi)) / (1 − E_avg),
 // which is reciprocal and keeps ∫ f cos ≤ 1 (the spec's per-half-vector (1 − F) weighting is
 // not white-furnace-safe at grazing angles). specular = 0 gives exactly baseColor/π.

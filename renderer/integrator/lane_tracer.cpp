@@ -19,8 +19,10 @@ using L::Mask;
 
 // ray_offset.h's nextFloatUp / nextFloatDown and offsetRayOrigin, lane by lane.
 Float nextFloatUp(Float v) {
-  const L::Int bits = L::Int(v);
-  const L::Int stepped = bits + ((v > 0.0f) & 2) - 1;  // + 1 above zero, − 1 below
+  // Unsigned lanes: −0.0f's pattern 0x80000000 minus 1 wraps (that lane is replaced below),
+  // where a signed lane overflowed, undefined behaviour that the sanitizer build aborts on.
+  const L::UInt bits = L::UInt(v);
+  const L::UInt stepped = bits + L::UInt((v > 0.0f) & 2) - 1u;  // + 1 above zero, − 1 below
   return L::select(v == 0.0f, L::splat(std::numeric_limits<float>::denorm_min()), Float(stepped));
 }
 Float nextFloatDown(Float v) {

@@ -17,6 +17,7 @@ namespace chorus::render::lanes {
 inline constexpr int kWidth = 4;
 using Float = float __attribute__((vector_size(16)));
 using Int = int32_t __attribute__((vector_size(16)));
+using UInt = uint32_t __attribute__((vector_size(16)));  // for bit arithmetic that may wrap
 using Mask = Int;  // −1 (true) or 0 in each lane, as comparisons produce
 
 inline Float splat(float v) {

@@ -1,7 +1,5 @@
 #include "renderer/scene/environment.h"
 
-#include <stb_image.h>
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -9,6 +7,9 @@
 
 #include "common/error.h"
 #include "common/image/exr_io.h"
+#include "common/regular_file.h"
+#include "renderer/scene/radiance_hdr.h"
+#include "renderer/scene/scene_limits.h"
 
 namespace chorus::render {
 namespace {
@@ -17,18 +18,6 @@ std::string lowerExtension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   return ext;
-}
-
-Image readHdr(const std::filesystem::path& path) {
-  int width = 0, height = 0, channels = 0;
-  float* pixels = stbi_loadf(path.c_str(), &width, &height, &channels, 3);
-  if (!pixels)
-    throw fileError(path, std::string("cannot read HDR image: ") +
-                              (stbi_failure_reason() ? stbi_failure_reason() : "unknown error"));
-  Image image(width, height, 3);
-  std::copy(pixels, pixels + size_t(width) * size_t(height) * 3, image.data());
-  stbi_image_free(pixels);
-  return image;
 }
 
 Image readExrRgb(const std::filesystem::path& path) {
@@ -45,23 +34,37 @@ Image readExrRgb(const std::filesystem::path& path) {
   return rgb;
 }
 
+bool inRadianceRange(float v) {
+  return v >= 0 && v <= kMaxRadiance;  // NaN: false
+}
+
 }  // namespace
 
+void checkEnvironment(const EnvironmentDesc& e) {
+  if (!std::isfinite(e.rotationDegrees))
+    throw Error("environment rotation " + shortNumber(e.rotationDegrees) +
+                " is not a finite number of degrees");
+  const std::string range = " must lie in [0, " + shortNumber(kMaxRadiance) + "]";
+  if (!inRadianceRange(e.intensity))
+    throw Error("environment intensity " + shortNumber(e.intensity) + range);
+  for (int c = 0; c < 3; ++c)
+    if (!inRadianceRange(e.radiance[c]))
+      throw Error("environment radiance " + shortNumber(e.radiance[c]) + range);
+}
+
 Image loadEnvironmentImage(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw fileError(path, "no such file");
+  requireRegularFile(path);
   const std::string ext = lowerExtension(path);
   Image image;
   if (ext == ".exr") {
     image = readExrRgb(path);
   } else if (ext == ".hdr" || ext == ".pic") {
-    image = readHdr(path);
+    image = readRadianceHdr(path);
   } else {
     throw fileError(path, "environment maps must be Radiance .hdr or OpenEXR .exr files");
   }
   if (image.width() < 1 || image.height() < 1) throw fileError(path, "is an empty image");
-  for (float& v : image.values())
-    if (!(v > 0) || !std::isfinite(v)) v = 0.0f;
+  for (float& v : image.values()) v = std::isfinite(v) ? std::clamp(v, 0.0f, kMaxRadiance) : 0.0f;
   return image;
 }
 
@@ -69,10 +72,11 @@ EnvironmentDesc environmentFromFile(const std::filesystem::path& path, float rot
                                     float intensity) {
   EnvironmentDesc e;
   e.kind = EnvironmentDesc::Kind::Map;
-  e.map = std::make_shared<const Image>(loadEnvironmentImage(path));
   e.source = path.string();
   e.rotationDegrees = rotationDegrees;
   e.intensity = intensity;
+  checkEnvironment(e);
+  e.map = std::make_shared<const Image>(loadEnvironmentImage(path));
   return e;
 }
 

@@ -32,11 +32,18 @@ struct EnvironmentDesc {
   }
 };
 
-// Reads a Radiance .hdr (stb_image) or OpenEXR (its default or only RGB layer) file as linear
-// RGB. Non-finite or negative texels become 0. Throws chorus::Error naming the file.
+// Throws chorus::Error unless the environment can be rendered: a finite rotation (NaN turned
+// every map lookup into index INT_MIN), an intensity and a constant radiance that are finite
+// and within [0, kMaxRadiance] (scene_limits.h). buildScene() checks its environment with this.
+void checkEnvironment(const EnvironmentDesc& environment);
+
+// Reads a Radiance .hdr (radiance_hdr.h) or OpenEXR (its default or only RGB layer) file as
+// linear RGB. Non-finite or negative texels become 0, texels above kMaxRadiance become
+// kMaxRadiance. Throws chorus::Error naming the file.
 Image loadEnvironmentImage(const std::filesystem::path& path);
 
-// loadEnvironmentImage wrapped in an EnvironmentDesc of kind Map.
+// loadEnvironmentImage wrapped in an EnvironmentDesc of kind Map (checked by checkEnvironment
+// before the file is read).
 EnvironmentDesc environmentFromFile(const std::filesystem::path& path, float rotationDegrees = 0,
                                     float intensity = 1);
 

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "common/error.h"
+#include "renderer/scene/scene_limits.h"
 
 namespace chorus::render::gltf {
 namespace {
@@ -94,6 +95,37 @@ uint32_t readIndexComponent(const unsigned char* p, int componentType) {
   }
 }
 
+bool isUnsignedIndexType(int componentType) {
+  return componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+         componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ||
+         componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+}
+
+// Whether `count` elements of `elementBytes` bytes, `stride` apart from `byteOffset`, fit in
+// `length` bytes. Offsets and strides come straight from the file, so no step may wrap.
+bool elementsFit(size_t byteOffset, size_t count, size_t stride, size_t elementBytes,
+                 size_t length) {
+  if (count == 0) return true;
+  if (byteOffset > length) return false;
+  size_t extent;
+  if (__builtin_mul_overflow(stride, count - 1, &extent) ||
+      __builtin_add_overflow(extent, elementBytes, &extent))
+    return false;
+  return extent <= length - byteOffset;
+}
+
+void checkCount(size_t count, const std::string& what) {
+  if (count > kMaxAccessorElements)
+    throw Error(what + " has count " + std::to_string(count) +
+                "; chorus reads accessors of at most " + std::to_string(kMaxAccessorElements) +
+                " elements");
+}
+
+size_t nonNegative(int value, const std::string& what) {
+  if (value < 0) throw Error(what + " is negative (" + std::to_string(value) + ")");
+  return size_t(value);
+}
+
 // A checked view of `count` elements of `elementBytes` bytes, `stride` apart, starting at
 // `byteOffset` inside buffer view `viewIndex`.
 struct ElementView {
@@ -117,12 +149,10 @@ ElementView viewElements(const tinygltf::Model& model, int viewIndex, size_t byt
                 std::to_string(view.buffer) + " (" + std::to_string(buffer.data.size()) +
                 " bytes; truncated file?)");
   const size_t stride = strideOverride ? strideOverride : elementBytes;
-  if (count > 0) {
-    const size_t last = byteOffset + stride * (count - 1) + elementBytes;
-    if (byteOffset > view.byteLength || last > view.byteLength || stride < elementBytes)
-      throw Error(what + " reads past the end of bufferView " + std::to_string(viewIndex));
-  }
-  return {buffer.data.data() + view.byteOffset + byteOffset, stride};
+  if (stride < elementBytes ||
+      !elementsFit(byteOffset, count, stride, elementBytes, view.byteLength))
+    throw Error(what + " reads past the end of bufferView " + std::to_string(viewIndex));
+  return {buffer.data.data() + view.byteOffset + (count > 0 ? byteOffset : 0), stride};
 }
 
 const tinygltf::Accessor& accessorAt(const tinygltf::Model& model, int index,
@@ -132,57 +162,72 @@ const tinygltf::Accessor& accessorAt(const tinygltf::Model& model, int index,
   return model.accessors[size_t(index)];
 }
 
+size_t viewStride(const tinygltf::Model& model, int viewIndex) {
+  return viewIndex >= 0 && size_t(viewIndex) < model.bufferViews.size()
+             ? model.bufferViews[size_t(viewIndex)].byteStride
+             : 0;
+}
+
 }  // namespace
 
 size_t accessorCount(const tinygltf::Model& model, int index, const std::string& what) {
-  return accessorAt(model, index, what).count;
+  const size_t count = accessorAt(model, index, what).count;
+  checkCount(count, what + " (accessor " + std::to_string(index) + ")");
+  return count;
 }
 
 std::vector<float> readFloats(const tinygltf::Model& model, int index, int components,
                               const std::string& what) {
   const tinygltf::Accessor& accessor = accessorAt(model, index, what);
   const std::string name = what + " (accessor " + std::to_string(index) + ")";
+  checkCount(accessor.count, name);
   const int size = componentSize(accessor.componentType);
   if (size == 0) throw Error(name + " has an invalid componentType");
   if (componentsOf(accessor.type) != components)
     throw Error(name + " has " + std::to_string(componentsOf(accessor.type)) +
                 " components, expected " + std::to_string(components));
   const size_t elementBytes = size_t(size) * size_t(components);
-  std::vector<float> out(accessor.count * size_t(components), 0.0f);
 
-  if (accessor.bufferView >= 0) {
-    const size_t byteStride = model.bufferViews.size() > size_t(accessor.bufferView)
-                                  ? model.bufferViews[size_t(accessor.bufferView)].byteStride
-                                  : 0;
-    const ElementView v = viewElements(model, accessor.bufferView, accessor.byteOffset,
-                                       accessor.count, elementBytes, byteStride, name);
+  ElementView dense;
+  if (accessor.bufferView >= 0)
+    dense = viewElements(model, accessor.bufferView, accessor.byteOffset, accessor.count,
+                         elementBytes, viewStride(model, accessor.bufferView), name);
+  ElementView sparseIndices, sparseValues;
+  size_t sparseCount = 0;
+  const int indexType = accessor.sparse.indices.componentType;
+  if (accessor.sparse.isSparse) {
+    sparseCount = nonNegative(accessor.sparse.count, name + " sparse count");
+    if (sparseCount > accessor.count)
+      throw Error(name + " has more sparse values (" + std::to_string(sparseCount) +
+                  ") than elements");
+    if (!isUnsignedIndexType(indexType))
+      throw Error(name + " has sparse indices of an invalid type");
+    sparseIndices = viewElements(
+        model, accessor.sparse.indices.bufferView,
+        nonNegative(accessor.sparse.indices.byteOffset, name + " sparse indices byteOffset"),
+        sparseCount, size_t(componentSize(indexType)), 0, name + " sparse indices");
+    sparseValues = viewElements(
+        model, accessor.sparse.values.bufferView,
+        nonNegative(accessor.sparse.values.byteOffset, name + " sparse values byteOffset"),
+        sparseCount, elementBytes, 0, name + " sparse values");
+  }
+
+  // Every view is checked: now the count is known to be backed by data (or bounded).
+  std::vector<float> out(accessor.count * size_t(components), 0.0f);
+  if (dense.first)
     for (size_t i = 0; i < accessor.count; ++i)
       for (int c = 0; c < components; ++c)
         out[i * size_t(components) + size_t(c)] =
-            readComponent(v.first + i * v.stride + size_t(c) * size_t(size), accessor.componentType,
-                          accessor.normalized);
-  }
-
-  if (accessor.sparse.isSparse) {
-    const size_t n = size_t(std::max(0, accessor.sparse.count));
-    const int indexType = accessor.sparse.indices.componentType;
-    const int indexSize = componentSize(indexType);
-    if (indexSize == 0 || indexType == TINYGLTF_COMPONENT_TYPE_FLOAT)
-      throw Error(name + " has sparse indices of an invalid type");
-    const ElementView idx = viewElements(model, accessor.sparse.indices.bufferView,
-                                         size_t(std::max(0, accessor.sparse.indices.byteOffset)), n,
-                                         size_t(indexSize), 0, name + " sparse indices");
-    const ElementView val = viewElements(model, accessor.sparse.values.bufferView,
-                                         size_t(std::max(0, accessor.sparse.values.byteOffset)), n,
-                                         elementBytes, 0, name + " sparse values");
-    for (size_t i = 0; i < n; ++i) {
-      const uint32_t target = readIndexComponent(idx.first + i * idx.stride, indexType);
-      if (target >= accessor.count) throw Error(name + " has a sparse index out of range");
-      for (int c = 0; c < components; ++c)
-        out[size_t(target) * size_t(components) + size_t(c)] =
-            readComponent(val.first + i * val.stride + size_t(c) * size_t(size),
+            readComponent(dense.first + i * dense.stride + size_t(c) * size_t(size),
                           accessor.componentType, accessor.normalized);
-    }
+  for (size_t i = 0; i < sparseCount; ++i) {
+    const uint32_t target =
+        readIndexComponent(sparseIndices.first + i * sparseIndices.stride, indexType);
+    if (target >= accessor.count) throw Error(name + " has a sparse index out of range");
+    for (int c = 0; c < components; ++c)
+      out[size_t(target) * size_t(components) + size_t(c)] =
+          readComponent(sparseValues.first + i * sparseValues.stride + size_t(c) * size_t(size),
+                        accessor.componentType, accessor.normalized);
   }
   return out;
 }
@@ -190,20 +235,15 @@ std::vector<float> readFloats(const tinygltf::Model& model, int index, int compo
 std::vector<uint32_t> readIndices(const tinygltf::Model& model, int index, size_t vertexCount) {
   const tinygltf::Accessor& accessor = accessorAt(model, index, "indices");
   const std::string name = "indices (accessor " + std::to_string(index) + ")";
+  checkCount(accessor.count, name);
   const int type = accessor.componentType;
-  if (type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-      type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-      type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
-    throw Error(name + " must be unsigned byte, short or int");
+  if (!isUnsignedIndexType(type)) throw Error(name + " must be unsigned byte, short or int");
   if (accessor.type != TINYGLTF_TYPE_SCALAR) throw Error(name + " must be scalar");
   if (accessor.bufferView < 0 || accessor.sparse.isSparse)
     throw Error(name + " must be a plain bufferView accessor");
-  const size_t size = size_t(componentSize(type));
-  const size_t byteStride = size_t(accessor.bufferView) < model.bufferViews.size()
-                                ? model.bufferViews[size_t(accessor.bufferView)].byteStride
-                                : 0;
-  const ElementView v = viewElements(model, accessor.bufferView, accessor.byteOffset,
-                                     accessor.count, size, byteStride, name);
+  const ElementView v =
+      viewElements(model, accessor.bufferView, accessor.byteOffset, accessor.count,
+                   size_t(componentSize(type)), viewStride(model, accessor.bufferView), name);
   std::vector<uint32_t> out(accessor.count);
   for (size_t i = 0; i < accessor.count; ++i) {
     out[i] = readIndexComponent(v.first + i * v.stride, type);

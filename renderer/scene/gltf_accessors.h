@@ -1,7 +1,9 @@
 #pragma once
 // Reading glTF accessors into plain arrays, with every bound checked (a malformed or truncated
-// file must fail with a message, never read out of bounds). Internal to the glTF loader.
-// Errors are thrown as chorus::Error without the file name; loadGltf() adds it.
+// file must fail with a message, never read out of bounds): counts are at most
+// kMaxAccessorElements (scene_limits.h), and offsets, strides and counts are checked against
+// their buffer view with arithmetic that cannot wrap before anything is allocated or read. Internal
+// to the glTF loader. Errors are thrown as chorus::Error without the file name; loadGltf() adds it.
 #include <tiny_gltf.h>
 
 #include <cstdint>
@@ -19,7 +21,8 @@ std::vector<float> readFloats(const tinygltf::Model& model, int index, int compo
 // An index accessor (unsigned byte, short or int scalars), checked against `vertexCount`.
 std::vector<uint32_t> readIndices(const tinygltf::Model& model, int index, size_t vertexCount);
 
-// The element count of accessor `index` (checked to exist).
+// The element count of accessor `index` (checked to exist and to be at most
+// kMaxAccessorElements), for budgets charged before any data is read.
 size_t accessorCount(const tinygltf::Model& model, int index, const std::string& what);
 
 }  // namespace chorus::render::gltf

@@ -4,19 +4,22 @@
 
 #include <algorithm>
 #include <array>
-#include <fstream>
+#include <cmath>
+#include <limits>
+#include <new>
 #include <set>
 
 #include "common/error.h"
+#include "common/memory_budget.h"
 #include "renderer/math/transform.h"
 #include "renderer/scene/gltf_accessors.h"
+#include "renderer/scene/gltf_file.h"
 #include "renderer/scene/gltf_materials.h"
 #include "renderer/scene/mesh_tangents.h"
+#include "renderer/scene/scene_limits.h"
 
 namespace chorus::render {
 namespace {
-
-constexpr int kMaxNodeDepth = 256;
 
 const std::set<std::string>& supportedExtensions() {
   static const std::set<std::string> names = {"KHR_materials_emissive_strength",
@@ -34,37 +37,47 @@ bool isMetadataExtension(const std::string& name) {
   return name == "KHR_xmp" || name == "KHR_xmp_json_ld" || name == "KHR_materials_variants";
 }
 
-// tinygltf's image callback: keep the encoded bytes; MaterialReader decodes the used images.
-bool keepEncodedImage(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
-                      const unsigned char* bytes, int size, void*) {
-  image->image.assign(bytes, bytes + size);
-  image->as_is = true;
-  return true;
-}
-
-std::string firstLine(const std::string& text) {
-  size_t begin = 0;
-  while (begin < text.size()) {
-    size_t end = text.find('\n', begin);
-    if (end == std::string::npos) end = text.size();
-    std::string line = text.substr(begin, end - begin);
-    while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
-    if (!line.empty()) return line;
-    begin = end + 1;
-  }
-  return "";
-}
-
-bool hasGlbMagic(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  char magic[4] = {};
-  in.read(magic, 4);
-  return in.gcount() == 4 && magic[0] == 'g' && magic[1] == 'l' && magic[2] == 'T' &&
-         magic[3] == 'F';
-}
-
 Vec3f vec3At(const std::vector<float>& v, size_t i) {
   return {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+}
+
+// Coordinates beyond kMaxCoordinate (or not finite) are an error; `what` ends in "at".
+void checkPosition(Vec3f p, const std::string& what) {
+  const auto inRange = [](float x) { return std::abs(x) <= kMaxCoordinate; };  // NaN: false
+  if (!(inRange(p.x) && inRange(p.y) && inRange(p.z)))
+    throw Error(what + " (" + shortNumber(p.x) + ", " + shortNumber(p.y) + ", " + shortNumber(p.z) +
+                "), outside the supported range of ±" + shortNumber(kMaxCoordinate));
+}
+
+// A radiance scale from the file: finite and at most kMaxRadiance.
+void checkRadiance(double v, const std::string& what) {
+  if (!(std::abs(v) <= double(kMaxRadiance)))
+    throw Error(what + " is " + shortNumber(v) + ", outside the supported range of ±" +
+                shortNumber(kMaxRadiance));
+}
+
+// Adds `amount` to a count bounded by `limit`; `what` names the count for the error message.
+void addToBudget(size_t* used, size_t amount, size_t limit, const std::string& what) {
+  if (amount > limit - *used)
+    throw Error("has more than " + std::to_string(limit) + " " + what +
+                ", the most chorus supports");
+  *used += amount;
+}
+
+// Throws chorus::Error (common/memory_budget.h) when the scene's geometry cannot fit in the
+// memory the machine has available.
+void checkMemory(size_t triangles, size_t vertices, uint64_t availableBytes) {
+  const double needed = double(triangles) * kBytesPerTriangle + double(vertices) * kBytesPerVertex;
+  checkMemoryBudget(uint64_t(needed),
+                    "loading " + std::to_string(triangles) + " triangles and " +
+                        std::to_string(vertices) + " vertices (instances included)",
+                    availableBytes);
+}
+
+// Triangles a primitive of `indexCount` indices makes in `mode`.
+size_t trianglesOf(size_t indexCount, int mode) {
+  if (mode == TINYGLTF_MODE_TRIANGLES) return indexCount / 3;
+  return indexCount >= 2 ? indexCount - 2 : 0;
 }
 
 // Triangle list indices for a primitive's topology (glTF 2.0 §3.7.2.1).
@@ -117,7 +130,10 @@ class SceneBuilder {
   void visit(int nodeIndex, const Transform& parent, int depth) {
     if (nodeIndex < 0 || size_t(nodeIndex) >= model_.nodes.size())
       throw Error("refers to missing node " + std::to_string(nodeIndex));
-    if (depth > kMaxNodeDepth) throw Error("node hierarchy is cyclic or deeper than 256");
+    if (depth > kMaxNodeDepth)
+      throw Error("node hierarchy is cyclic or deeper than " + std::to_string(kMaxNodeDepth));
+    addToBudget(&nodeInstances_, 1, kMaxNodeInstances,
+                "node instances (a node counts once per path from the root)");
     const tinygltf::Node& node = model_.nodes[size_t(nodeIndex)];
     const Transform worldFromNode = parent * localTransform(node);
     const std::string label =
@@ -165,15 +181,25 @@ class SceneBuilder {
     const int positionAccessor = attribute("POSITION");
     if (positionAccessor < 0) throw Error(label + " has no POSITION");
 
+    addToBudget(&primitiveInstances_, 1, kMaxPrimitiveInstances, "mesh primitive instances");
+    // The budgets are charged from the accessor counts before any data is read or allocated.
+    const size_t vertexCount = gltf::accessorCount(model_, positionAccessor, label + " POSITION");
+    addToBudget(&vertices_, vertexCount, kMaxSceneVertices, "vertices over all instances");
+    const size_t indexCount = prim.indices >= 0
+                                  ? gltf::accessorCount(model_, prim.indices, label + " indices")
+                                  : vertexCount;
+    addToBudget(&triangles_, trianglesOf(indexCount, mode), kMaxSceneTriangles,
+                "triangles over all instances");
+    checkMemory(triangles_, vertices_, availableBytes_);
+
     MeshDesc mesh;
     mesh.name = label;
     const std::vector<float> positions =
         gltf::readFloats(model_, positionAccessor, 3, label + " POSITION");
-    const size_t vertexCount = positions.size() / 3;
     mesh.positions.resize(vertexCount);
     for (size_t i = 0; i < vertexCount; ++i) {
       mesh.positions[i] = worldFromObject.point(vec3At(positions, i));
-      if (!isFinite(mesh.positions[i])) throw Error(label + " has non-finite positions");
+      checkPosition(mesh.positions[i], label + " has a vertex at");
     }
 
     std::vector<uint32_t> indices;
@@ -228,11 +254,11 @@ class SceneBuilder {
 
   std::vector<float> readVertexAttribute(int accessor, int components, size_t vertexCount,
                                          const std::string& what) {
-    std::vector<float> v = gltf::readFloats(model_, accessor, components, what);
-    if (v.size() != vertexCount * size_t(components))
-      throw Error(what + " has " + std::to_string(v.size() / size_t(components)) +
-                  " elements but POSITION has " + std::to_string(vertexCount));
-    return v;
+    const size_t count = gltf::accessorCount(model_, accessor, what);
+    if (count != vertexCount)
+      throw Error(what + " has " + std::to_string(count) + " elements but POSITION has " +
+                  std::to_string(vertexCount));
+    return gltf::readFloats(model_, accessor, components, what);
   }
 
   void addCamera(const tinygltf::Node& node, const std::string& label,
@@ -242,17 +268,28 @@ class SceneBuilder {
     const tinygltf::Camera& gc = model_.cameras[size_t(node.camera)];
     CameraDesc c;
     c.name = gc.name.empty() ? label : "'" + gc.name + "'";
+    double aspect = 0;  // 0: none given
     if (gc.type == "orthographic") {
       c.projection = ProjectionType::Orthographic;
-      c.xmag = float(std::abs(gc.orthographic.xmag));
-      c.ymag = float(std::abs(gc.orthographic.ymag));
-      if (!(c.xmag > 0 && c.ymag > 0)) throw Error("camera " + c.name + " has xmag or ymag 0");
-      c.aspectRatio = c.xmag / c.ymag;
+      const double xmag = std::abs(gc.orthographic.xmag), ymag = std::abs(gc.orthographic.ymag);
+      for (const double mag : {xmag, ymag})
+        if (!(mag > 0 && mag <= double(kMaxCoordinate)))
+          throw Error("camera " + c.name + " has xmag " + shortNumber(xmag) + " and ymag " +
+                      shortNumber(ymag) + "; each must lie in (0, " + shortNumber(kMaxCoordinate) +
+                      "]");
+      c.xmag = float(xmag);
+      c.ymag = float(ymag);
+      aspect = xmag / ymag;
     } else {
       c.yfov = float(gc.perspective.yfov);
       if (!(c.yfov > 0 && c.yfov < kPi)) throw Error("camera " + c.name + " has an invalid yfov");
-      c.aspectRatio = gc.perspective.aspectRatio > 0 ? float(gc.perspective.aspectRatio) : 0.0f;
+      if (gc.perspective.aspectRatio > 0) aspect = gc.perspective.aspectRatio;
     }
+    if (aspect != 0 && !(aspect >= kMinCameraAspect && aspect <= kMaxCameraAspect))
+      throw Error("camera " + c.name + " has aspect ratio " + shortNumber(aspect) +
+                  ", outside the supported " + shortNumber(kMinCameraAspect) + " … " +
+                  shortNumber(kMaxCameraAspect));
+    c.aspectRatio = float(aspect);
     // Orthonormal frame; scale in the node transform only moves the camera, it does not zoom.
     c.position = worldFromCamera.point({0, 0, 0});
     c.forward = normalize(worldFromCamera.vector({0, 0, -1}));
@@ -261,6 +298,7 @@ class SceneBuilder {
     c.up = cross(c.right, c.forward);
     if (!isFinite(c.forward) || !isFinite(c.right))
       throw Error(label + " has a degenerate camera transform");
+    checkPosition(c.position, "camera " + c.name + " is at");
     out_.cameras.push_back(c);
   }
 
@@ -277,9 +315,12 @@ class SceneBuilder {
     } else if (gl.type != "point") {
       throw Error("light " + l.name + " has unknown type '" + gl.type + "'");
     }
-    if (gl.color.size() >= 3)
+    if (gl.color.size() >= 3) {
+      for (int i = 0; i < 3; ++i) checkRadiance(gl.color[size_t(i)], "light " + l.name + " color");
       l.color = Rgb{float(std::max(0.0, gl.color[0])), float(std::max(0.0, gl.color[1])),
                     float(std::max(0.0, gl.color[2]))};
+    }
+    checkRadiance(gl.intensity, "light " + l.name + " intensity");
     l.intensity = float(std::max(0.0, gl.intensity));
     l.position = worldFromLight.point({0, 0, 0});
     l.direction = normalize(worldFromLight.vector({0, 0, -1}));
@@ -287,6 +328,7 @@ class SceneBuilder {
     l.innerConeAngle = float(std::clamp(gl.spot.innerConeAngle, 0.0, double(l.outerConeAngle)));
     if (!isFinite(l.position) || !isFinite(l.direction))
       throw Error(label + " has a degenerate light transform");
+    checkPosition(l.position, "light " + l.name + " is at");
     out_.lights.push_back(l);
   }
 
@@ -294,6 +336,8 @@ class SceneBuilder {
   SceneDesc& out_;
   gltf::MaterialReader materials_;
   int skippedPrimitives_ = 0;
+  size_t nodeInstances_ = 0, primitiveInstances_ = 0, triangles_ = 0, vertices_ = 0;
+  const uint64_t availableBytes_ = availableMemoryBytes();  // read once per scene
 };
 
 void checkExtensions(const tinygltf::Model& model, SceneDesc& out) {
@@ -317,27 +361,20 @@ bool isSupportedGltfExtension(const std::string& name) {
 }
 
 SceneDesc loadGltf(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw fileError(path, "no such file");
-
-  tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(keepEncodedImage, nullptr);
-  tinygltf::Model model;
-  std::string err, warn;
-  const bool ok = hasGlbMagic(path) ? loader.LoadBinaryFromFile(&model, &err, &warn, path.string())
-                                    : loader.LoadASCIIFromFile(&model, &err, &warn, path.string());
-  if (!ok) {
-    const std::string reason = firstLine(err);
-    throw fileError(path, "not a readable glTF file" + (reason.empty() ? "" : ": " + reason));
-  }
-
   SceneDesc out;
   out.source = path;
   try {
-    checkExtensions(model, out);
-    SceneBuilder(model, out).build();
-  } catch (const Error& e) {
-    throw fileError(path, e.what());
+    tinygltf::Model model;
+    gltf::readModel(path, &model);  // its errors name the file
+    try {
+      checkExtensions(model, out);
+      SceneBuilder(model, out).build();
+    } catch (const Error& e) {
+      throw fileError(path, e.what());
+    }
+  } catch (const std::bad_alloc&) {
+    // Within the limits of scene_limits.h a scene can still outgrow this machine's memory.
+    throw fileError(path, "needs more memory than is available");
   }
   if (out.meshes.empty()) throw fileError(path, "contains no triangles to render");
   return out;

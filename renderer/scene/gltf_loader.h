@@ -16,7 +16,8 @@
 namespace chorus::render {
 
 // Throws chorus::Error "<path>: <problem>" for a missing, malformed or truncated file, a missing
-// buffer or texture image, or an unsupported required extension.
+// buffer or texture image, an unsupported required extension, or anything beyond the limits of
+// scene_limits.h (counts, instances, coordinates, camera parameters, radiances, memory).
 SceneDesc loadGltf(const std::filesystem::path& path);
 
 // Extensions chorus implements (the rest are ignored with a warning, or rejected when required).

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <tbb/parallel_for.h>
 
 #include "common/error.h"
+#include "renderer/scene/scene_limits.h"
 #include "renderer/scene/texture.h"
 
 namespace chorus::render::gltf {
@@ -22,12 +24,20 @@ double number(const tinygltf::Value& object, const char* key, double fallback) {
   return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
 }
 
+// A double from the file as a float, clamped to the finite floats (1e39 would become +inf, and
+// inf · 0 makes NaN downstream); non-finite values become 0.
+float finiteFloat(double v) {
+  constexpr double kLargest = std::numeric_limits<float>::max();
+  return std::isfinite(v) ? float(std::clamp(v, -kLargest, kLargest)) : 0.0f;
+}
+
 Rgb color3(const tinygltf::Value& object, const char* key, Rgb fallback) {
   if (!object.Has(key)) return fallback;
   const tinygltf::Value& v = object.Get(key);
   if (!v.IsArray() || v.ArrayLen() < 3) return fallback;
   Rgb c;
-  for (int i = 0; i < 3; ++i) c[i] = v.Get(i).IsNumber() ? float(v.Get(i).GetNumberAsDouble()) : 0;
+  for (int i = 0; i < 3; ++i)
+    c[i] = v.Get(i).IsNumber() ? finiteFloat(v.Get(i).GetNumberAsDouble()) : 0;
   return c;
 }
 
@@ -93,7 +103,7 @@ int MaterialReader::materialIndex(int gltfIndex) {
 MaterialDesc MaterialReader::convert(const tinygltf::Material& gm, int gltfIndex) {
   MaterialDesc m;
   m.name = gm.name.empty() ? "material " + std::to_string(gltfIndex) : "'" + gm.name + "'";
-  const std::string label = "material " + m.name;
+  const std::string label = gm.name.empty() ? m.name : "material " + m.name;
   const tinygltf::PbrMetallicRoughness& pbr = gm.pbrMetallicRoughness;
 
   if (pbr.baseColorFactor.size() >= 4) {
@@ -112,8 +122,14 @@ MaterialDesc MaterialReader::convert(const tinygltf::Material& gm, int gltfIndex
   m.normalScale = std::isfinite(gm.normalTexture.scale) ? float(gm.normalTexture.scale) : 1.0f;
 
   float emissiveStrength = 1.0f;
-  if (const tinygltf::Value* ext = findExtension(gm.extensions, "KHR_materials_emissive_strength"))
-    emissiveStrength = float(std::max(0.0, number(*ext, "emissiveStrength", 1.0)));
+  if (const tinygltf::Value* ext =
+          findExtension(gm.extensions, "KHR_materials_emissive_strength")) {
+    const double strength = number(*ext, "emissiveStrength", 1.0);
+    if (!(std::abs(strength) <= double(kMaxRadiance)))
+      throw Error(label + " has emissiveStrength " + shortNumber(strength) +
+                  ", outside the supported range of ±" + shortNumber(kMaxRadiance));
+    emissiveStrength = float(std::max(0.0, strength));
+  }
   m.emissive = clampColor01(rgbFrom(gm.emissiveFactor, Rgb(0.0f))) * emissiveStrength;
   if (m.isEmissive())
     m.emissiveTexture =

@@ -161,6 +161,7 @@ Scene& Scene::operator=(Scene&&) noexcept = default;
 Scene::~Scene() = default;
 
 Scene buildScene(SceneDesc desc, EnvironmentDesc environment) {
+  checkEnvironment(environment);
   Scene scene;
   SceneData& data = *scene.data_;
   data.source = desc.source;

@@ -145,7 +145,8 @@ class Scene {
 
 // Builds the runtime scene (takes ownership of the desc's arrays). With no emissive material,
 // no punctual light and no environment, the environment becomes a uniform white radiance of 1
-// (see Scene::usesDefaultEnvironment). Throws chorus::Error when Embree fails.
+// (see Scene::usesDefaultEnvironment). Throws chorus::Error for an environment
+// checkEnvironment() rejects, or when Embree fails.
 Scene buildScene(SceneDesc desc, EnvironmentDesc environment);
 
 }  // namespace chorus::render

@@ -7,6 +7,7 @@
 
 #include "common/error.h"
 #include "common/image/exr_io.h"
+#include "common/image/finite_pixels.h"
 #include "denoise/metrics/metrics.h"
 #include "tools/chorus/command.h"
 
@@ -35,6 +36,9 @@ void runCompare(const CompareArgs& args) {
                                     " is " + std::to_string(reference.width()) + "x" +
                                     std::to_string(reference.height()) + "x" +
                                     std::to_string(reference.channels()));
+  // One NaN would turn every metric into NaN: refuse rather than print nulls.
+  requireFinitePixels(image, args.image);
+  requireFinitePixels(reference, args.reference);
   const ImageMetrics m = computeMetrics(image, reference);
   if (args.json) {
     nlohmann::ordered_json j;

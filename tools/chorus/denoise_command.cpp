@@ -19,7 +19,9 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/image/exr_io.h"
+#include "common/image/finite_pixels.h"
 #include "common/image/png_io.h"
+#include "common/owned_directory.h"
 #include "common/stopwatch.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/buffers_exr.h"
@@ -29,6 +31,7 @@
 #include "tools/chorus/command.h"
 #include "tools/chorus/ensemble_flags.h"
 #include "tools/chorus/ensemble_outputs.h"
+#include "tools/chorus/flag_checks.h"
 
 namespace chorus::cli {
 namespace {
@@ -187,11 +190,13 @@ void runDenoise(const DenoiseArgs& args) {
   const std::vector<Combiner> combiners = combinersOf(args.combine, specs.size());
   const CombineOptions options = args.ensemble.options();
   const fs::path out = args.out;
+  const OwnedDirectory owned(out);  // one run at a time in DIR
 
   ReadInput input = readInput(args.input, specs);
   std::optional<Image> reference;
   if (!args.reference.empty()) {
     reference = readRgbExr(args.reference);
+    requireFinitePixels(*reference, args.reference);
     checkReferenceSize(*reference, args.reference, input.width(), input.height());
   }
   for (Combiner c : combiners)
@@ -283,7 +288,7 @@ const RegisterCommand registration(40, [](CLI::App& app) {
                   "Comma-separated base denoisers: built-in specs (name or name:key=value) for a "
                   "render.exr or Tungsten directory, folder names for a directory of outputs")
       ->required();
-  cmd->add_option("--out", args->out, "Output directory")->required();
+  cmd->add_option("--out", args->out, "Output directory")->required()->transform(nonEmpty());
   cmd->add_option("--combine", args->combine,
                   "none (each method alone on the full buffer: DIR/<method>.exr/.png), or a "
                   "combiner or comma-separated list of them: ensemble, average, onehot-pre, "

@@ -1,6 +1,7 @@
 #include "tools/chorus/ensemble_flags.h"
 
 #include "common/error.h"
+#include "tools/chorus/flag_checks.h"
 
 namespace chorus::cli {
 
@@ -17,44 +18,54 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
       ->capture_default_str();
   cmd.add_option("--estimate", estimate,
                  "What the MSE estimate compares: halves (each member's runs on half A and B with "
-                 "the other half) or quarters (its runs on three quarters with the fourth: "
-                 "4 more runs per member, needs 4 sub-buffers)")
+                 "the other half), quarters (its runs on three quarters with the fourth: "
+                 "4 more runs per member, needs 4 sub-buffers) or extrapolated (1.5 x quarters "
+                 "- 0.5 x halves)")
       ->capture_default_str();
   cmd.add_option("--window", window,
                  "Radius of the feature-guided window the MSE estimate is accumulated over "
                  "(0 = per pixel, as in the paper)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(integerIn(0, kMaxWindowRadius));
   cmd.add_flag("--relative,!--absolute", relative,
                "Divide the MSE estimate by (mean² + 0.01) so that it targets relMSE");
   cmd.add_option("--outlier-cap", outlierCap,
                  "Scale each pixel's MSE terms by F/(trace + F) before the window (trace in units "
                  "of mean|x|²), so that a firefly counts about as much as F in its neighbours' "
                  "windows (0 = off)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(finiteIn(0, kMaxEnsembleFactor));
   cmd.add_option("--consistency", consistency,
                  "Give a base weight 0 where its full-buffer output lies more than K times half "
                  "the A/B difference (+10%) from the mean of its half outputs (0 = off)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(finiteIn(0, kMaxEnsembleFactor));
   cmd.add_option("--plausibility", plausibility,
                  "Give a base weight 0 where its own error term exceeds K² times the least base's "
                  "plus the noisy halves' difference (0 = off, else at least 1)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(zeroOrFiniteIn(1, kMaxEnsembleFactor));
   cmd.add_option("--image-prior", imagePrior,
                  "Add A times the image-wide mean of the (relative) MSE terms, scaled to each "
                  "pixel's own, to the pixel's estimate: shrinkage towards the best blend over the "
                  "image (0 = off; previews: 0 unless given)")
       ->capture_default_str()
+      ->transform(finiteIn(0, kMaxEnsembleFactor))
       ->each([this](const std::string&) { imagePriorGiven = true; });
   cmd.add_option("--noisy-fallback", noisyFallback,
                  "Use the noisy value where even the best base's own error term exceeds K² times "
                  "the noisy halves' difference (+10%): every base is far from both halves "
                  "(0 = off, else at least 1)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(zeroOrFiniteIn(1, kMaxEnsembleFactor));
   cmd.add_option("--member-fallback", memberFallback,
                  "Use the member closest to the noisy data where the blend's own error term "
                  "exceeds K² times that member's plus the noise (0 = off, else at least 1)")
-      ->capture_default_str();
-  cmd.add_option("--solver-seed", seed, "Seed of the pairwise solver")->capture_default_str();
+      ->capture_default_str()
+      ->transform(zeroOrFiniteIn(1, kMaxEnsembleFactor));
+  cmd.add_option("--solver-seed", seed, "Seed of the pairwise solver")
+      ->capture_default_str()
+      ->transform(anyUnsigned64());
 }
 
 CombineOptions EnsembleFlags::options() const {
@@ -74,23 +85,14 @@ CombineOptions EnsembleFlags::options() const {
     o.mse.estimate = MseEstimate::Extrapolated;
   else
     throw Error("unknown --estimate '" + estimate + "' (known: halves, quarters, extrapolated)");
-  if (window < 0) throw Error("--window must be at least 0");
+  // The numbers were range-checked when the flags were parsed (addFlags).
   o.mse.windowRadius = window;
   o.mse.relative = relative;
-  if (!(outlierCap >= 0)) throw Error("--outlier-cap must be at least 0");
-  if (!(consistency >= 0)) throw Error("--consistency must be at least 0");
   o.mse.outlierCap = outlierCap;
   o.mse.consistency = consistency;
-  if (!(plausibility == 0 || plausibility >= 1))
-    throw Error("--plausibility must be 0 (off) or at least 1");
   o.mse.plausibility = plausibility;
-  if (!(imagePrior >= 0)) throw Error("--image-prior must be at least 0");
   o.mse.imagePrior = imagePrior;
-  if (!(noisyFallback == 0 || noisyFallback >= 1))
-    throw Error("--noisy-fallback must be 0 (off) or at least 1");
   o.mse.noisyFallback = noisyFallback;
-  if (!(memberFallback == 0 || memberFallback >= 1))
-    throw Error("--member-fallback must be 0 (off) or at least 1");
   o.mse.memberFallback = memberFallback;
   if (weightFilter != "bilateral" && weightFilter != "none")
     throw Error("unknown --weight-filter '" + weightFilter + "' (known: bilateral, none)");

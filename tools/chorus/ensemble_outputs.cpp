@@ -2,9 +2,12 @@
 
 #include <cctype>
 #include <cmath>
+#include <functional>
+#include <iostream>
 
 #include "common/error.h"
 #include "common/image/exr_io.h"
+#include "common/image/output_values.h"
 #include "common/image/png_io.h"
 #include "denoise/metrics/metrics.h"
 
@@ -58,23 +61,44 @@ nlohmann::ordered_json combineOptionsJson(const CombineOptions& o) {
           {"solver_seed", o.seed}};
 }
 
+std::vector<ExrLayer> writeRepairedExr(const std::filesystem::path& path,
+                                       std::vector<ExrLayer> layers,
+                                       const std::function<bool(const std::string&)>& isSigned) {
+  OutputRepairs repairs;
+  for (ExrLayer& layer : layers) {
+    const OutputRepairs r = repairForOutput(layer.image, isSigned && isSigned(layer.name));
+    repairs.nonFinite += r.nonFinite;
+    repairs.negative += r.negative;
+  }
+  if (repairs.total() > 0)
+    std::cerr << "chorus: warning: " << path.string() << ": " << repairs.nonFinite
+              << " NaN/Inf values written as 0 (+Inf as the largest float), " << repairs.negative
+              << " negative radiance values as 0\n";
+  writeExr(path, layers);
+  return layers;
+}
+
 void writeCombined(const std::filesystem::path& dir, const std::string& name,
                    const CombineResult& result, const std::vector<BaseOutputs>& bases,
                    const std::string& weightsFile) {
-  writeExr(dir / (name + ".exr"), {{"", result.image},
-                                   {"A", result.imageA},
-                                   {"B", result.imageB},
-                                   {"mseEstimate", result.mseEstimate}});
-  writePng(dir / (name + ".png"), result.image);
+  const std::vector<ExrLayer> written =
+      writeRepairedExr(dir / (name + ".exr"),
+                       {{"", result.image},
+                        {"A", result.imageA},
+                        {"B", result.imageB},
+                        {"mseEstimate", result.mseEstimate}},
+                       [](const std::string& layer) { return layer == "mseEstimate"; });
+  writePng(dir / (name + ".png"), written.front().image);
   std::vector<ExrLayer> weights;
   for (size_t i = 0; i < bases.size(); ++i) weights.push_back({bases[i].name, result.weights[i]});
   if (!result.noisyFallback.empty()) weights.push_back({"noisyFallback", result.noisyFallback});
-  writeExr(dir / weightsFile, weights);
+  // Weights may be negative (oracle-unconstrained).
+  writeRepairedExr(dir / weightsFile, std::move(weights), [](const std::string&) { return true; });
 }
 
 void writeBaseOutputs(const std::filesystem::path& dir, const std::vector<BaseOutputs>& bases) {
   for (const BaseOutputs& base : bases)
-    writeExr(dir / (base.name + ".exr"), {{"", base.full}, {"A", base.a}, {"B", base.b}});
+    writeRepairedExr(dir / (base.name + ".exr"), {{"", base.full}, {"A", base.a}, {"B", base.b}});
 }
 
 }  // namespace chorus::cli

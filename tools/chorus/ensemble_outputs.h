@@ -5,9 +5,11 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
+#include "common/image/exr_io.h"
 #include "denoise/pipeline/ensemble.h"
 
 namespace chorus::cli {
@@ -28,8 +30,15 @@ nlohmann::ordered_json metricsJson(const Image& image, const Image& reference);
 // The options of a combination, for stats.json.
 nlohmann::ordered_json combineOptionsJson(const CombineOptions& options);
 
+// Writes the layers after repairForOutput (common/image/output_values.h: no NaN/Inf, and no
+// negative radiance except in the layers `isSigned` names), with one warning line on stderr
+// counting what was replaced. Returns the layers as written.
+std::vector<ExrLayer> writeRepairedExr(
+    const std::filesystem::path& path, std::vector<ExrLayer> layers,
+    const std::function<bool(const std::string&)>& isSigned = {});
+
 // DIR/<name>.exr (layers: RGB = the blend, A, B, mseEstimate), DIR/<name>.png and the weight
-// maps as DIR/<weightsFile>, one layer per base.
+// maps as DIR/<weightsFile>, one layer per base (all through writeRepairedExr).
 void writeCombined(const std::filesystem::path& dir, const std::string& name,
                    const CombineResult& result, const std::vector<BaseOutputs>& bases,
                    const std::string& weightsFile);

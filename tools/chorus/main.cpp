@@ -41,6 +41,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("chorus ") + CHORUS_VERSION);
   app.require_subcommand(1);
   app.fallthrough();
+  // One line per error (bad input: one line naming the flag or file, exit code 2).
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return "chorus: " + std::string(e.what()) + " (--help lists the flags)\n";
+  });
   addAllCommands(app);
   try {
     app.parse(argc, argv);

@@ -11,13 +11,17 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/image/exr_io.h"
+#include "common/image/finite_pixels.h"
 #include "common/image/png_io.h"
+#include "common/owned_directory.h"
 #include "common/stopwatch.h"
 #include "denoise/buffers/buffers_exr.h"
 #include "renderer/render.h"
 #include "tools/chorus/command.h"
 #include "tools/chorus/ensemble_flags.h"
 #include "tools/chorus/ensemble_outputs.h"
+#include "tools/chorus/flag_checks.h"
+#include "tools/chorus/memory_estimate.h"
 #include "tools/chorus/progress_bar.h"
 #include "tools/chorus/render_denoise.h"
 #include "tools/chorus/scene_options.h"
@@ -84,6 +88,23 @@ nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderStats& s,
   return j;
 }
 
+// Every file this run writes in DIR, stats.json last (OwnedDirectory::replacePreviousRun).
+std::vector<std::string> outputFiles(const RenderArgs& args, const DenoiseStage& denoise) {
+  std::vector<std::string> files;
+  if (!args.preview)
+    files = {"render.exr", "color.png"};
+  else if (!denoise.enabled())
+    files = {"color.png"};
+  if (denoise.enabled() && denoise.writeExrs) {
+    files.insert(files.end(), {"denoised.exr", "denoised.png", "weights.exr"});
+    for (const EnsembleMember& member : denoise.members) files.push_back(member.label + ".exr");
+  } else if (denoise.enabled()) {
+    files.push_back("denoised.png");
+  }
+  files.push_back("stats.json");
+  return files;
+}
+
 void runRender(RenderArgs args) {
   const Stopwatch total;
   if (args.preview && !args.sppGiven) args.sceneOptions.render.spp = 4;
@@ -93,12 +114,15 @@ void runRender(RenderArgs args) {
   std::optional<Image> reference;
   if (!args.reference.empty()) {
     if (!denoise.enabled()) throw Error("--reference needs --denoise");
-    reference = readRgbExr(args.reference);  // fails before the render; size checked after
+    reference = readRgbExr(args.reference);
+    requireFinitePixels(*reference, args.reference);
   }
   const LoadedScene loaded = loadScene(args.scene, args.sceneOptions, args.quiet);
-  const fs::path out = args.out;
-  if (fs::exists(out) && !fs::is_directory(out))  // fail before the render, not after
-    throw fileError(out, "cannot create directory: it is a file");
+  // Everything that can be checked fails here, before the render allocates its film.
+  const Resolution size = renderResolution(loaded.scene, options);
+  if (reference) checkReferenceSize(*reference, args.reference, size.width, size.height);
+  checkRunMemory(size, options.splits, denoise.members);
+  OwnedDirectory out(args.out);  // held until every file is written
 
   ProgressBar bar(!args.quiet && ProgressBar::stderrIsTerminal());
   RenderResult result =
@@ -114,7 +138,10 @@ void runRender(RenderArgs args) {
                  static_cast<unsigned long long>(s.nanSamplesDropped));
   }
 
-  ensureDirectory(out);
+  // The previous run's files go before the first of this run's is written (a killed render
+  // leaves them untouched; a run killed while writing leaves no stats.json).
+  const std::vector<std::string> files = outputFiles(args, denoise);
+  out.replacePreviousRun(files);
   nlohmann::ordered_json stats = statsJson(args, result.stats, loaded);
   // The denoisers' inputs are copies, so the buffers can move into render.exr's layers (no
   // second copy of a large render in memory), and render.exr is on disk before denoising. A
@@ -124,36 +151,29 @@ void runRender(RenderArgs args) {
     sources = args.preview
                   ? sourcesFromBuffers(std::move(result.buffers), readsHalves(denoise.members))
                   : sourcesFromBuffers(result.buffers);
-  std::string written;
   const Stopwatch write;
   if (!args.preview) {
     const std::vector<ExrLayer> layers = sampleBuffersToLayers(std::move(result.buffers));
-    writeExr(out / "render.exr", layers, ExrPixelType::Float);
-    writePng(out / "color.png", layers.front().image);  // the full-buffer colour mean
-    written = "render.exr color.png ";
+    writeExr(out.path() / "render.exr", layers, ExrPixelType::Float);
+    writePng(out.path() / "color.png", layers.front().image);  // the full-buffer colour mean
   } else if (!sources) {
-    writePng(out / "color.png", result.buffers.part(BufferPart::Full).color.mean);
-    written = "color.png ";
+    writePng(out.path() / "color.png", result.buffers.part(BufferPart::Full).color.mean);
   }
   stats["seconds"]["write render"] = write.seconds();
   result.buffers = {};
   double denoiseSeconds = 0;
-  if (reference)  // checked after render.exr is safe on disk
-    checkReferenceSize(*reference, args.reference, result.stats.width, result.stats.height);
-  if (sources) {
-    denoiseSeconds = denoise.run(*sources, out, stats, reference ? &*reference : nullptr);
-    written +=
-        denoise.writeExrs ? "denoised.exr denoised.png weights.exr <member>.exr " : "denoised.png ";
-  }
-  written += "stats.json";
+  if (sources)
+    denoiseSeconds = denoise.run(*sources, out.path(), stats, reference ? &*reference : nullptr);
   stats["seconds"]["total"] = total.seconds();
-  writeTextAtomically(out / "stats.json", stats.dump(2) + "\n");
+  writeTextAtomically(out.path() / "stats.json", stats.dump(2) + "\n");
 
   if (!args.quiet) {
     if (sources)
       std::fprintf(stderr, "chorus: denoised with %s (%s) in %.2f s\n", denoise.label().c_str(),
                    args.combine.c_str(), denoiseSeconds);
-    std::fprintf(stderr, "chorus: wrote %s in %s\n", written.c_str(), out.c_str());
+    std::string written;
+    for (const std::string& file : files) written += (written.empty() ? "" : " ") + file;
+    std::fprintf(stderr, "chorus: wrote %s in %s\n", written.c_str(), out.path().c_str());
   }
 }
 
@@ -164,11 +184,13 @@ const RegisterCommand registration(30, [](CLI::App& app) {
       "Path-trace a glTF scene into independent sub-buffers (colour, albedo, normal, "
       "depth, visibility, with variances); writes DIR/render.exr, color.png, stats.json");
   cmd->add_option("scene", args->scene, "glTF scene (.gltf or .glb)")->required();
-  cmd->add_option("--out", args->out, "Output directory")->capture_default_str();
+  cmd->add_option("--out", args->out, "Output directory")
+      ->capture_default_str()
+      ->transform(nonEmpty());
   cmd->add_option("--spp", args->sceneOptions.render.spp,
                   "Samples per pixel (over all sub-buffers)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber)
+      ->transform(integerIn(1, kMaxSpp))
       ->each([args](const std::string&) { args->sppGiven = true; });
   cmd->add_option("--splits", args->splits,
                   "Independent sub-buffers K: 1, 2 or 4 (default: what --denoise needs; with "
@@ -192,7 +214,8 @@ const RegisterCommand registration(30, [](CLI::App& app) {
                     "denoised.png and stats.json");
   cmd->add_option("--reference", args->reference,
                   "Reference image (.exr) of the same view: metrics of the noisy input, each "
-                  "member and the result in stats.json");
+                  "member and the result in stats.json")
+      ->transform(nonEmpty());
   args->ensemble.addFlags(*cmd);
   cmd->add_flag("--quiet", args->quiet, "No progress bar or summary line");
   cmd->callback([args] { runRender(*args); });

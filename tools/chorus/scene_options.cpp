@@ -2,29 +2,61 @@
 
 #include <iostream>
 
+#include "common/error.h"
+
 #include "common/stopwatch.h"
+#include "common/thread_limit.h"
 #include "renderer/scene/environment.h"
 #include "renderer/scene/gltf_loader.h"
+#include "tools/chorus/flag_checks.h"
 
 namespace chorus::cli {
 
 using namespace chorus::render;
 
+namespace {
+
+// Far beyond the cameras of any scene; the index only has to stay an int.
+constexpr int64_t kMaxCameraIndex = 1'000'000;
+
+// --background: parseRgb's R,G,B (or grey) with non-negative components, each at most
+// kMaxRadianceScale.
+CLI::Validator radianceColour() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        try {
+          const Rgb rgb = parseRgb(text);
+          if (rgb.maxComponent() > kMaxRadianceScale)
+            return "'" + text + "' is brighter than 1e+06 in some channel";
+        } catch (const Error& e) {
+          return e.what();
+        }
+        return {};
+      },
+      "R,G,B");
+}
+
+}  // namespace
+
 void SceneOptions::addFlags(CLI::App& cmd) {
-  cmd.add_option("--width", render.width, "Image width (default: from the camera)");
-  cmd.add_option("--height", render.height, "Image height (default: 512, or from --width)");
-  cmd.add_option("--seed", render.seed, "Sampler seed")->capture_default_str();
+  cmd.add_option("--width", render.width, "Image width (default: from the camera)")
+      ->transform(integerIn(1, kMaxImageSide));
+  cmd.add_option("--height", render.height, "Image height (default: 512, or from --width)")
+      ->transform(integerIn(1, kMaxImageSide));
+  cmd.add_option("--seed", render.seed, "Sampler seed")
+      ->capture_default_str()
+      ->transform(anyUnsigned64());
   cmd.add_option("--threads", render.threads, "Worker threads (0: all cores)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->transform(integerIn(0, kMaxThreads));
   cmd.add_option("--max-depth", render.maxDepth, "Maximum bounces per path")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->transform(integerIn(1, kMaxDepth));
   cmd.add_option("--roulette-depth", render.rouletteStartDepth,
                  "Russian roulette from this bounce on (above --max-depth: never; the expected "
                  "image is the same, only the noise and the time per sample change)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->transform(integerIn(0, kMaxDepth + 1));
   cmd.add_option_function<std::string>(
          "--tracer",
          [this](const std::string& name) {
@@ -38,16 +70,19 @@ void SceneOptions::addFlags(CLI::App& cmd) {
       ->default_str("auto");
   cmd.add_option("--camera", render.camera, "Camera index (glTF camera nodes in order)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->transform(integerIn(0, kMaxCameraIndex));
   auto* backgroundFlag = cmd.add_option("--background", background,
-                                        "Constant environment radiance R,G,B (or one grey value)");
-  auto* envFlag = cmd.add_option("--env", env, "Equirectangular environment map (.hdr or .exr)");
+                                        "Constant environment radiance R,G,B (or one grey value)")
+                             ->transform(radianceColour());
+  auto* envFlag = cmd.add_option("--env", env, "Equirectangular environment map (.hdr or .exr)")
+                      ->transform(nonEmpty());
   backgroundFlag->excludes(envFlag);
   cmd.add_option("--env-rotate", envRotate, "Rotate the environment about +Y, degrees")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(finiteIn(-360, 360));
   cmd.add_option("--env-intensity", envIntensity, "Scale the environment radiance")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->transform(finiteIn(0, kMaxRadianceScale));
 }
 
 EnvironmentDesc SceneOptions::environment() const {

@@ -10,10 +10,13 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/owned_directory.h"
 #include "common/thread_limit.h"
 #include "denoise/base/registry.h"
 #include "tools/chorus/command.h"
 #include "tools/chorus/ensemble_flags.h"
+#include "tools/chorus/flag_checks.h"
+#include "tools/chorus/memory_estimate.h"
 #include "tools/chorus/scene_options.h"
 #include "tools/sweep/report_html.h"
 #include "tools/sweep/sweep_directory.h"
@@ -23,6 +26,11 @@ namespace chorus::cli {
 namespace {
 
 namespace fs = std::filesystem;
+
+// A budget below 10 ms is shorter than any probe render; 1e7 s (four months) is past any sweep.
+constexpr double kMinReferenceSeconds = 0.01, kMaxReferenceSeconds = 1e7;
+// The report embeds every crop as a PNG: a side beyond this would make it megabytes per case.
+constexpr int64_t kMaxCropSize = 1024;
 
 struct SweepArgs {
   std::vector<std::string> scenes, references, merge;
@@ -82,6 +90,7 @@ void runMerge(const SweepArgs& args) {
   sweep::ReportInfo info;
   info.details = "merged from: " + joined(args.merge);
   std::vector<fs::path> inputs(args.merge.begin(), args.merge.end());
+  const OwnedDirectory out(args.out, {"cases", "references"});
   printHeadline(args.out, sweep::mergeSweeps(args.out, inputs, info));
 }
 
@@ -91,6 +100,10 @@ void runSweepCommand(const SweepArgs& args) {
   sweep::SweepConfig config;
   config.scenes.assign(args.scenes.begin(), args.scenes.end());
   config.spps = sweep::parseIntList(args.spp, "--spp");
+  for (int spp : config.spps)
+    if (spp > kMaxSpp)
+      throw Error("--spp '" + args.spp + "': " + std::to_string(spp) + " is above " +
+                  std::to_string(kMaxSpp));
   config.methods = splitMethodList(args.methods.empty() ? defaultMethods() : args.methods);
   config.combos = args.combos;
   config.combiners = splitMethodList(args.combiners);
@@ -103,13 +116,21 @@ void runSweepCommand(const SweepArgs& args) {
   config.environment = args.scene.environment();
   config.combine = args.ensemble.options();
   config.cropSize = args.cropSize;
+  // Every case renders with K = 4 and runs every method: checked before anything is written
+  // when --width and --height fix the size, else as each scene is loaded (its camera decides).
+  const std::vector<EnsembleMember> members = membersFromSpecs(config.methods);
+  if (config.render.width > 0 && config.render.height > 0)
+    checkRunMemory({config.render.width, config.render.height}, 4, members);
   config.loadScene = [&](const fs::path& path) {
-    return std::move(loadScene(path.string(), args.scene, args.quiet).scene);
+    render::Scene scene = std::move(loadScene(path.string(), args.scene, args.quiet).scene);
+    checkRunMemory(render::renderResolution(scene, config.render), 4, members);
+    return scene;
   };
   config.progress = args.quiet ? nullptr : &std::cerr;
   config.report.details = describe(config, args);
   // Denoisers run on TBB: --threads limits them as it limits the renderer.
   const ThreadLimit threads(config.render.threads);
+  const OwnedDirectory out(config.out, {"cases", "references"});  // held for the whole sweep
 
   const sweep::SweepRunStats stats = sweep::runSweep(config);
   if (!args.quiet)
@@ -126,7 +147,9 @@ const RegisterCommand registration(50, [](CLI::App& app) {
       "once, evaluate every combination with every combiner against a reference; writes "
       "DIR/results.csv and a self-contained DIR/report.html");
   cmd->add_option("scenes", args->scenes, "glTF scenes (.gltf or .glb)");
-  cmd->add_option("--out", args->out, "Output directory (reruns resume from it)")->required();
+  cmd->add_option("--out", args->out, "Output directory (reruns resume from it)")
+      ->required()
+      ->transform(nonEmpty());
   cmd->add_option("--spp", args->spp, "Comma-separated samples per pixel")->capture_default_str();
   cmd->add_option("--methods", args->methods,
                   "Comma-separated base denoisers (default: every built-in one)");
@@ -140,22 +163,24 @@ const RegisterCommand registration(50, [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--reference", args->references,
                   "Reference EXR, once per scene in scene order (default: rendered into "
-                  "DIR/references/)");
+                  "DIR/references/)")
+      ->transform(nonEmpty());
   cmd->add_option("--reference-spp", args->referenceSpp, "Samples per pixel of rendered references")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->transform(integerIn(1, kMaxSpp));
   cmd->add_option("--reference-seconds", args->referenceSeconds,
                   "Render each reference for about this long instead (spp from a 16-spp probe)")
-      ->check(CLI::PositiveNumber);
+      ->transform(finiteIn(kMinReferenceSeconds, kMaxReferenceSeconds));
   cmd->add_option("--shard", args->shard,
                   "I/N: run only the cases whose index mod N is I (for job arrays)")
       ->capture_default_str();
   cmd->add_option("--merge", args->merge,
                   "Combine the sweep directories of sharded runs into --out (no scenes)")
-      ->expected(1, -1);
+      ->expected(1, -1)
+      ->transform(nonEmpty());
   cmd->add_option("--crop-size", args->cropSize, "Side of the report's crops, pixels")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->transform(integerIn(1, kMaxCropSize));
   args->scene.addFlags(*cmd);
   args->ensemble.addFlags(*cmd);
   cmd->add_flag("--quiet", args->quiet, "No progress lines");

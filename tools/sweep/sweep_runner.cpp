@@ -12,6 +12,7 @@
 #include "common/error.h"
 #include "common/image/exr_io.h"
 #include "common/image/false_color.h"
+#include "common/image/finite_pixels.h"
 #include "common/image/png_io.h"
 #include "common/stopwatch.h"
 #include "denoise/metrics/metrics.h"
@@ -194,11 +195,11 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
   render::RenderOptions options = config.render;
   options.spp = c.spp;
   options.splits = 4;
-  const render::RenderResult render = render::render(scene, options);
-  if (!reference.sameSize(render.buffers.sub(0).color.mean))
+  const render::Resolution size = render::renderResolution(scene, options);
+  if (reference.width() != size.width || reference.height() != size.height)  // before rendering
     throw fileError(referenceFile, "is " + sizeText(reference.width(), reference.height()) +
-                                       " but the renders are " +
-                                       sizeText(render.buffers.width(), render.buffers.height()));
+                                       " but the renders are " + sizeText(size.width, size.height));
+  const render::RenderResult render = render::render(scene, options);
   const double renderSeconds = render.stats.renderSeconds;
 
   const EnsembleSources sources = sourcesFromBuffers(render.buffers);
@@ -288,8 +289,11 @@ SweepRunStats runSweep(const SweepConfig& config) {
   if (!config.references.empty() && config.references.size() != config.scenes.size())
     throw Error("--reference given " + std::to_string(config.references.size()) + " times for " +
                 std::to_string(config.scenes.size()) + " scenes (one per scene, in scene order)");
-  for (const fs::path& reference : config.references)
+  for (const fs::path& reference : config.references) {
     if (!fs::is_regular_file(reference)) throw fileError(reference, "no such file");
+    // A NaN in a reference makes every row's metrics NaN: refused before anything runs.
+    requireFinitePixels(readRgbExr(reference), reference);
+  }
   if (config.cropSize < 1) throw Error("crop size must be positive");
   const Plan plan = makePlan(config);
   claimDirectory(config);

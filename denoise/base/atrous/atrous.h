@@ -33,8 +33,8 @@ struct AtrousParams {
   float sigmaZ = 1.0f;          // σ_z: depth tolerance in units of the depth gradient (SVGF)
   float sigmaN = 128.0f;        // σ_n: exponent of the normal weight (SVGF)
   float sigmaL = 4.0f;          // σ_l: luminance tolerance in noise standard deviations (SVGF)
-  bool demodulate = true;       // filter colour / albedo (measured: see README)
-  bool clampFireflies = false;  // clamp luminance to 10× the 3×3 median first (see README)
+  bool demodulate = true;       // filter colour / albedo (measured: docs/members/)
+  bool clampFireflies = false;  // clamp luminance to 10× the 3×3 median first (docs/members/)
 
   // Reads overrides: iterations, sigmaZ, sigmaN, sigmaL, demodulate, clampFireflies.
   // Throws chorus::Error for a value out of range.

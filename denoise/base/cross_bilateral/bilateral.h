@@ -15,9 +15,10 @@
 namespace chorus {
 
 struct BilateralParams {
-  float sigmaS = 4.0f;   // spatial width, pixels (our choice by measurement, see README)
+  float sigmaS = 4.0f;   // spatial width, pixels (our choice by measurement, see
+                         // docs/members/sbf-atrous-bilateral.md)
   float sigmaC = 3.0f;   // colour range width in noise standard deviations; 0 = no colour term
-                         // (our choice by measurement, see README)
+                         // (our choice by measurement, see docs/members/sbf-atrous-bilateral.md)
   float sigmaN = 0.8f;   // normal range width (SBF release default)
   float sigmaR = 0.25f;  // reflectance (albedo) range width (SBF release default)
   float sigmaD = 0.6f;   // depth range width on depth / largest finite depth (SBF release default)

@@ -21,7 +21,8 @@
 namespace chorus {
 
 struct JointNlMeansParams {
-  int r = 4;           // window radius: (2r+1)² neighbours (the speed target decides, README)
+  int r =
+      4;  // window radius: (2r+1)² neighbours (the speed target decides, docs/members/rdfc-jnlm.md)
   int f = 2;           // colour patch radius
   float k = 0.45f;     // colour sensitivity (Rousselle et al.'s NL-means)
   float alpha = 1.0f;  // strength of the variance cancellation

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "common/error.h"
 #include "denoise/base/filters/collaborative_regression.h"
+#include "denoise/base/filters/local_range.h"
 #include "denoise/base/filters/nlmeans_filter.h"
 #include "denoise/base/variance_estimates.h"
 
@@ -44,6 +46,9 @@ namespace {
 
 // Radiance beyond this is treated as this, so that squared errors stay finite in float.
 constexpr float kMaxMagnitude = 1e12f;
+// How far beyond its window's data range (in units of that range) a regression's prediction
+// may go before the NL-means average replaces it.
+constexpr float kImplausibleMargin = 0.5f;
 
 float sanitizeValue(float v) {
   return std::isfinite(v) ? std::clamp(v, -kMaxMagnitude, kMaxMagnitude) : 0.0f;
@@ -204,7 +209,39 @@ class NforRun {
                            .epsilon = p_.epsilon,
                            .distanceClamp = p_.distanceClamp,
                            .channels = ChannelWeights::MinOverChannels};
-    return collaborativeRegression(image, features, NlMeansWeights(term, window(r)));
+    const NlMeansWeights weights(term, window(r));
+    Image out = collaborativeRegression(image, features, weights);
+    fallBackWhereImplausible(out, image, weights, r);
+    return out;
+  }
+
+  // Where the regression's prediction leaves the range of the data in the pixel's window by
+  // more than half that range (or is not finite), the pixel takes the NL-means average of the
+  // data with the same weights instead, which stays inside it. A fit that extrapolates that far
+  // rests on an ill-conditioned window: defocused or noisy features, a firefly at the edge of
+  // the window (docs/outliers.md). On ordinary windows the prediction never gets there.
+  static void fallBackWhereImplausible(Image& out, const Image& image,
+                                       const NlMeansWeights& weights, int r) {
+    const LocalRange range = localRange(image, r);
+    std::vector<size_t> implausible;
+    const int channels = out.channels();
+    for (size_t i = 0; i < out.pixelCount(); ++i)
+      for (int c = 0; c < channels; ++c) {
+        const size_t e = i * size_t(channels) + size_t(c);
+        const float lo = range.lo.data()[e], hi = range.hi.data()[e], v = out.data()[e];
+        const float margin = kImplausibleMargin * (hi - lo);
+        if (lo <= hi && !(v >= lo - margin && v <= hi + margin)) {
+          implausible.push_back(i);
+          break;
+        }
+      }
+    if (implausible.empty()) return;
+    const Image average = nlMeansFilter(image, weights);
+    for (size_t i : implausible)
+      for (int c = 0; c < channels; ++c) {
+        const size_t e = i * size_t(channels) + size_t(c);
+        out.data()[e] = average.data()[e];
+      }
   }
 
   // e = ½[(c2 − y1)² − 2σ² + (c1 − y2)² − 2σ²] − ¼(y2 − y1)²: the error of the average of the

@@ -1,0 +1,269 @@
+#include "denoise/base/outlier_guard.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <vector>
+
+#include "denoise/util/parallel_rows.h"
+
+namespace chorus {
+namespace {
+
+constexpr int kMaxRadius = 4;
+constexpr int kMaxNeighbours = (2 * kMaxRadius + 1) * (2 * kMaxRadius + 1) - 1;
+// Fewer finite neighbours than this (tiny images, NaN regions) say too little: nothing clamped.
+constexpr int kMinNeighbours = 4;
+// MAD × this estimates the standard deviation of a normal distribution.
+constexpr double kMadToSigma = 1.4826;
+constexpr float kMaxFloat = std::numeric_limits<float>::max();
+// A few units in the last place of a float, relative.
+constexpr double kFloatResolution = 1e-6;
+
+// The sample count of pixel i, or 0 ("unknown") when the buffer has none recorded.
+float countAt(const SubBuffer& buffer, size_t i) {
+  return buffer.sampleCount.sameSize(buffer.color.mean) ? buffer.sampleCount.data()[i] : 0.0f;
+}
+
+// Whether a pixel's samples support an excess over the neighbourhood level: the excess is more
+// than `sigmas` standard errors of the mean. Fewer than 2 samples give no variance (0 by
+// convention), so nothing is confirmed; an unknown count (0) trusts a positive variance.
+// A variance at FLT_MAX is saturated (the film clamps there: the square of a radiance above
+// ~1.8e19), a lower bound that confirms nothing.
+bool samplesConfirm(double excess, float variance, float count, double sigmas) {
+  const bool measured = count == 0.0f ? variance > 0.0f : count >= 2.0f;
+  return measured && variance >= 0.0f && variance < kMaxFloat &&
+         excess > sigmas * std::sqrt(double(variance));
+}
+
+// The pixel's mean with its largest sample taken out, assuming that sample is the one outlier
+// among n and the other n − 1 spread like the neighbours' samples (per-sample variance
+// n σ_N²): from M2 = M2' + (V − m')² (n − 1)/n with M2' = (n − 2) n σ_N²,
+//   m' = m − √(max(0, v − σ_N² (n − 2)/(n − 1))),  v the variance of the mean.
+// (One sample V among zeros: v = (V/n)², m' = 0.) A pixel with fewer than 2 samples has only
+// the outlier: the neighbourhood level stands in for it.
+// The subtraction is only meaningful while float's resolution of the mean (and of its
+// standard error) is finer than the neighbours' noise; beyond that the level stands in too.
+double withoutLargestSample(double mean, float variance, float count, double level, double noise) {
+  const double n = count;
+  if (!(variance >= 0.0f && variance < kMaxFloat) || (n > 0.0 && n < 2.0)) return level;
+  if (std::abs(mean) * kFloatResolution > noise) return level;
+  if (n == 0.0) return mean - std::sqrt(double(variance));  // count unknown
+  const double rest = n > 2.0 ? noise * noise * (n - 2.0) / (n - 1.0) : 0.0;
+  return mean - std::sqrt(std::max(0.0, double(variance) - rest));
+}
+
+struct PixelStats {
+  double mean;
+  float variance;  // of the mean
+  float count;     // 0: unknown
+};
+
+// Colour channel c of pixel i of two independent buffers pooled (Chan et al.'s update, as in
+// merge()); equal weights when they record no sample counts, the variance then at least the
+// two-buffer estimate ¼ (m1 − m2)².
+PixelStats mergedAt(const SubBuffer& a, const SubBuffer& b, size_t i, int c) {
+  const double n0 = std::max(0.0f, countAt(a, i)), n1 = std::max(0.0f, countAt(b, i));
+  const double n = n0 + n1;
+  const size_t e = i * 3 + size_t(c);
+  const double m0 = a.color.mean.data()[e], m1 = b.color.mean.data()[e];
+  const double v0 = a.color.varianceOfMean.data()[e], v1 = b.color.varianceOfMean.data()[e];
+  if (!(n > 0)) {
+    const double mean = 0.5 * (m0 + m1);
+    const double variance = std::max(0.25 * (v0 + v1), 0.25 * (m0 - m1) * (m0 - m1));
+    return {mean, float(std::min(variance, double(kMaxFloat))), 0.0f};
+  }
+  const double mean = (n0 * m0 + n1 * m1) / n;
+  const double m2 = n0 * ((n0 > 1 ? v0 * (n0 - 1) : 0.0) + (m0 - mean) * (m0 - mean)) +
+                    n1 * ((n1 > 1 ? v1 * (n1 - 1) : 0.0) + (m1 - mean) * (m1 - mean));
+  const double variance = n >= 2 ? m2 / (n * (n - 1)) : 0.0;
+  return {mean, float(std::min(variance, double(kMaxFloat))), float(n)};
+}
+
+class PartGuard {
+ public:
+  PartGuard(const SubBuffer& part, const SubBuffer* other, const OutlierGuardOptions& options)
+      : part_(part), other_(other), o_(options) {}
+
+  // Clamps the outliers of the part's colour into `out` (a copy of it); marks the pixels that
+  // changed. Returns how many values changed.
+  size_t run(MeanVariance& out, std::vector<uint8_t>& changed) const {
+    const int h = part_.height();
+    std::vector<size_t> rowCounts(size_t(h), 0);
+    std::vector<std::vector<Excess>> rowExcess(static_cast<size_t>(h));
+    parallelRows(0, h, [&](int y) {
+      rowCounts[size_t(y)] = guardRow(y, out, changed, rowExcess[size_t(y)]);
+    });
+    // In raster order, so that the sums do not depend on the thread count.
+    for (const std::vector<Excess>& excesses : rowExcess)
+      for (const Excess& excess : excesses) spread(excess, out, changed);
+    return std::accumulate(rowCounts.begin(), rowCounts.end(), size_t(0));
+  }
+
+ private:
+  // What an outlier had above its replacement, to be spread over its neighbourhood.
+  struct Excess {
+    int x, y, c;
+    double amount;
+  };
+
+  // Adds amount × k(q) / Σ k to every pixel q of the (2 spreadRadius + 1)² window inside the
+  // image, the outlier's own included, with the Gaussian k(q) = exp(−|q − p|² / (2 (r/2)²)): the
+  // window keeps the outlier's energy, without the edges a box would draw.
+  void spread(const Excess& e, MeanVariance& out, std::vector<uint8_t>& changed) const {
+    const int w = part_.width(), h = part_.height(), r = o_.spreadRadius;
+    const int x0 = std::max(0, e.x - r), x1 = std::min(w - 1, e.x + r);
+    const int y0 = std::max(0, e.y - r), y1 = std::min(h - 1, e.y + r);
+    const double falloff = 2.0 / (double(r) * double(r));  // 1 / (2 σ²), σ = r / 2
+    auto kernel = [&](int x, int y) {
+      const double dx = x - e.x, dy = y - e.y;
+      return std::exp(-(dx * dx + dy * dy) * falloff);
+    };
+    double total = 0;
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) total += kernel(x, y);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) {
+        float& m = out.mean(x, y, e.c);
+        m = float(std::min(double(m) + e.amount * kernel(x, y) / total, double(kMaxFloat)));
+        changed[size_t(y) * size_t(w) + size_t(x)] = 1;
+      }
+  }
+
+  size_t guardRow(int y, MeanVariance& out, std::vector<uint8_t>& changed,
+                  std::vector<Excess>& excesses) const {
+    const Image& mean = part_.color.mean;
+    const Image& variance = part_.color.varianceOfMean;
+    const int w = mean.width(), h = mean.height(), r = o_.radius;
+    std::array<float, kMaxNeighbours> values, spreads;
+    size_t clamped = 0;
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float value = mean(x, y, c);
+        if (!std::isfinite(value)) continue;
+        int count = 0, below = 0;
+        for (int qy = std::max(0, y - r); qy <= std::min(h - 1, y + r); ++qy)
+          for (int qx = std::max(0, x - r); qx <= std::min(w - 1, x + r); ++qx) {
+            if (qx == x && qy == y) continue;
+            const float m = mean(qx, qy, c);
+            if (!std::isfinite(m)) continue;
+            below += m < value;
+            values[size_t(count++)] = m;
+          }
+        if (count < kMinNeighbours) continue;
+        // Q = the value exceeded by `highRank` neighbours. value > Q exactly when at most
+        // highRank neighbours reach it: most pixels stop here, before any sorting.
+        const int highRank = count / 12;
+        if (count - below > highRank) continue;
+        float* first = values.data();
+        std::nth_element(first, first + highRank, first + count, std::greater<float>());
+        const double high = first[highRank];
+        std::nth_element(first, first + count / 2, first + count);
+        const double level = first[count / 2];
+
+        int spreadCount = 0;
+        for (int qy = std::max(0, y - r); qy <= std::min(h - 1, y + r); ++qy)
+          for (int qx = std::max(0, x - r); qx <= std::min(w - 1, x + r); ++qx) {
+            if (qx == x && qy == y) continue;
+            const float v = variance(qx, qy, c);
+            if (std::isfinite(v) && v >= 0.0f && std::isfinite(mean(qx, qy, c)))
+              spreads[size_t(spreadCount++)] = std::sqrt(v);
+          }
+        double noise = 0;
+        if (spreadCount > 0) {
+          std::nth_element(spreads.data(), spreads.data() + spreadCount / 2,
+                           spreads.data() + spreadCount);
+          noise = spreads[size_t(spreadCount / 2)];
+        }
+        for (int i = 0; i < count; ++i) spreads[size_t(i)] = float(std::abs(first[i] - level));
+        std::nth_element(spreads.data(), spreads.data() + count / 2, spreads.data() + count);
+        noise = std::max(noise, kMadToSigma * spreads[size_t(count / 2)]);
+
+        const double ceiling =
+            std::max(level + o_.ceilingSigmas * noise, high > 0 ? o_.highFactor * high : high);
+        if (!(value > ceiling)) continue;
+        const size_t pixel = size_t(y) * size_t(w) + size_t(x);
+        // The evidence: the pixel's samples in this part, or in both halves when the other
+        // half has the pixel (a second, independent firefly in the other half does not make
+        // two halves that agree: their pooled samples still do not confirm the excess).
+        const bool pool = other_ && std::isfinite(other_->color.mean(x, y, c));
+        const PixelStats evidence =
+            pool ? mergedAt(part_, *other_, pixel, c)
+                 : PixelStats{value, variance(x, y, c), countAt(part_, pixel)};
+        if (samplesConfirm(evidence.mean - level, evidence.variance, evidence.count,
+                           o_.confirmSigmas))
+          continue;
+        const double replacement =
+            withoutLargestSample(value, variance(x, y, c), countAt(part_, pixel), level, noise);
+        const double clampedValue = std::clamp(replacement, std::min(0.0, level), ceiling);
+        out.mean(x, y, c) = float(clampedValue);
+        // Peers: neighbours that deviate from L as much make the RMS deviation of the
+        // neighbourhood comparable to this excess. The outlier is then one of many samples of
+        // a heavy-tailed distribution present here (a caustic), whose energy is part of the
+        // image: it is spread over the window rather than dropped.
+        double squares = 0;
+        for (int i = 0; i < count; ++i) squares += (first[i] - level) * (first[i] - level);
+        if (value - level <= o_.peerSigmas * std::sqrt(squares / count))
+          excesses.push_back({x, y, c, value - clampedValue});
+        const double excess = clampedValue - level;
+        const double cap = std::max(noise * noise, excess * excess);
+        const float v = variance(x, y, c);
+        out.varianceOfMean(x, y, c) =
+            std::isfinite(v) ? float(std::min(double(v), cap)) : float(std::min(cap, 3.0e38));
+        changed[pixel] = 1;
+        ++clamped;
+      }
+    return clamped;
+  }
+
+  const SubBuffer& part_;
+  const SubBuffer* other_;
+  const OutlierGuardOptions& o_;
+};
+
+// The whole's colour at pixel i re-merged from the two halves.
+void remergeColor(const std::array<SubBuffer, 2>& halves, size_t i, SubBuffer& whole) {
+  for (int c = 0; c < 3; ++c) {
+    const PixelStats merged = mergedAt(halves[0], halves[1], i, c);
+    whole.color.mean.data()[i * 3 + size_t(c)] = float(merged.mean);
+    whole.color.varianceOfMean.data()[i * 3 + size_t(c)] = merged.variance;
+  }
+}
+
+}  // namespace
+
+GuardedInput guardOutliers(DenoiseInput input, const OutlierGuardOptions& options) {
+  if (options.radius < 1 || options.radius > kMaxRadius)
+    throw std::invalid_argument("guardOutliers: radius must be in [1, 4]");
+  GuardedInput result;
+  if (options.ceilingSigmas == 0.0f) {
+    result.input = std::move(input);
+    return result;
+  }
+  // The guard reads the input as given and writes into its own copy of the colour.
+  std::vector<uint8_t> changed(input.whole.color.mean.pixelCount(), 0);
+  if (!input.halves) {
+    MeanVariance color = input.whole.color;
+    result.clampedValues = PartGuard(input.whole, nullptr, options).run(color, changed);
+    input.whole.color = std::move(color);
+    result.input = std::move(input);
+    return result;
+  }
+  auto& halves = *input.halves;
+  std::array<MeanVariance, 2> colors = {halves[0].color, halves[1].color};
+  for (int k = 0; k < 2; ++k)
+    result.clampedValues += PartGuard(halves[size_t(k)], &halves[size_t(1 - k)], options)
+                                .run(colors[size_t(k)], changed);
+  for (int k = 0; k < 2; ++k) halves[size_t(k)].color = std::move(colors[size_t(k)]);
+  if (result.clampedValues > 0)
+    for (size_t i = 0; i < changed.size(); ++i)
+      if (changed[i]) remergeColor(halves, i, input.whole);
+  result.input = std::move(input);
+  return result;
+}
+
+}  // namespace chorus

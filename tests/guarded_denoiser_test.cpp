@@ -1,0 +1,179 @@
+// The safety around every built-in member (denoise/base/guarded_denoiser.h) piece by piece:
+// filling NaN/Inf colour, the power-of-two radiance scale, the output's finish, the decorator
+// itself; and the two small helpers the writers and NFOR use (output_values.h, local_range.h).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "common/error.h"
+#include "common/image/output_values.h"
+#include "denoise/base/filters/local_range.h"
+#include "denoise/base/guarded_denoiser.h"
+#include "denoise/base/nonfinite_fill.h"
+#include "denoise/base/radiance_scale.h"
+#include "denoise/base/registry.h"
+#include "tests/support/test_support.h"
+
+namespace chorus {
+namespace {
+
+constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kMax = std::numeric_limits<float>::max();
+
+SubBuffer constantBuffer(int w, int h, float value) {
+  SubBuffer s = SubBuffer::zeros(w, h);
+  s.color.mean.fill(value);
+  s.color.varianceOfMean.fill(0.01f);
+  s.sampleCount.fill(4);
+  return s;
+}
+
+TEST(NonFiniteFill, HolesTakeTheirNeighboursValues) {
+  SubBuffer s = constantBuffer(10, 8, 2.5f);
+  s.color.mean(3, 3, 1) = kNan;  // one value
+  for (int y = 2; y < 7; ++y)
+    for (int x = 5; x < 9; ++x) s.color.mean(x, y, 0) = y == 4 ? -kInf : kNan;  // a block
+  EXPECT_EQ(fillNonFiniteColor(s), 1u + 20u);
+  for (float v : s.color.mean.values()) EXPECT_EQ(v, 2.5f);
+  EXPECT_FLOAT_EQ(s.color.varianceOfMean(6, 4, 0), 0.01f);  // the neighbours' variance
+}
+
+TEST(NonFiniteFill, MedianOfTheFiniteNeighbours) {
+  SubBuffer s = constantBuffer(3, 3, 0.0f);
+  const float values[9] = {1, 2, 3, 4, kNan, 6, 7, 100, 9};
+  for (int i = 0; i < 9; ++i) s.color.mean(i % 3, i / 3, 0) = values[i];
+  fillNonFiniteColor(s);
+  EXPECT_EQ(s.color.mean(1, 1, 0), 6.0f);  // the upper median of {1, 2, 3, 4, 6, 7, 9, 100}
+}
+
+TEST(NonFiniteFill, AChannelWithNoFiniteValueBecomesZero) {
+  SubBuffer s = constantBuffer(4, 4, kNan);
+  fillNonFiniteColor(s);
+  for (float v : s.color.mean.values()) EXPECT_EQ(v, 0.0f);
+}
+
+TEST(RadianceScale, OrdinaryRadianceIsLeftAlone) {
+  DenoiseInput in;
+  in.whole = constantBuffer(4, 4, 1000.0f);
+  in.whole.color.mean(1, 1, 0) = 1e-4f;
+  EXPECT_EQ(radianceScaleExponent(in), 0);
+}
+
+TEST(RadianceScale, HugeAndTinyRadianceAreBroughtIntoRange) {
+  DenoiseInput huge;
+  huge.whole = constantBuffer(4, 4, 3e38f);
+  huge.whole.color.varianceOfMean.fill(kMax);
+  const int down = radianceScaleExponent(huge);
+  EXPECT_GT(down, 0);
+  EXPECT_LE(std::ldexp(3e38, -down), std::ldexp(1.0, kMaxRadianceExponent));
+  EXPECT_GT(std::ldexp(3e38, -down), std::ldexp(1.0, kMaxRadianceExponent - 1));
+
+  DenoiseInput tiny;
+  tiny.whole = constantBuffer(4, 4, 3e-30f);
+  tiny.whole.color.varianceOfMean.fill(0.0f);
+  const int up = radianceScaleExponent(tiny);
+  EXPECT_LT(up, 0);
+  const double scaled = std::ldexp(3e-30, -up);
+  EXPECT_GE(scaled, 0.5);
+  EXPECT_LT(scaled, 1.0);
+}
+
+TEST(RadianceScale, PowersOfTwoChangeNoBits) {
+  DenoiseInput in;
+  in.whole = constantBuffer(5, 5, 0.0f);
+  for (size_t i = 0; i < in.whole.color.mean.size(); ++i) {
+    in.whole.color.mean.data()[i] = 0.1f + 0.37f * float(i);
+    in.whole.color.varianceOfMean.data()[i] = 0.01f * float(i);
+  }
+  DenoiseInput scaled = in;
+  scaleColor(scaled, -37);
+  scaleColor(scaled, 37);
+  for (size_t i = 0; i < in.whole.color.mean.size(); ++i) {
+    EXPECT_EQ(scaled.whole.color.mean.data()[i], in.whole.color.mean.data()[i]);
+    EXPECT_EQ(scaled.whole.color.varianceOfMean.data()[i], in.whole.color.varianceOfMean.data()[i]);
+  }
+  Image image = in.whole.color.mean;
+  scaleImage(image, 200);  // beyond float: kept at the largest float
+  for (float v : image.values()) EXPECT_EQ(v, kMax);
+}
+
+TEST(RadianceScale, SaturatedVariancesUseTheTwoBufferEstimate) {
+  // Halves 1e30 · (1 ± 0.1): the variance of the mean is unrepresentable (the film stores
+  // FLT_MAX); scaled down, it becomes the two-buffer estimate ¼ (h1 − h2)² in relative form,
+  // here exactly ¼ (0.2 · 1e30)² · 2^(−2e) since every pixel is alike.
+  DenoiseInput in;
+  in.halves =
+      std::array<SubBuffer, 2>{constantBuffer(6, 6, 1.1e30f), constantBuffer(6, 6, 0.9e30f)};
+  in.whole = constantBuffer(6, 6, 1e30f);
+  in.whole.color.varianceOfMean.fill(kMax);
+  for (SubBuffer& half : *in.halves) half.color.varianceOfMean.fill(kMax);
+  const int e = radianceScaleExponent(in);
+  scaleColor(in, -e);
+  const double expectedWhole = 0.25 * std::pow(std::ldexp(0.2e30, -e), 2);
+  EXPECT_NEAR(in.whole.color.varianceOfMean(3, 3, 0), expectedWhole, 1e-4 * expectedWhole);
+  EXPECT_NEAR((*in.halves)[0].color.varianceOfMean(3, 3, 0), 2 * expectedWhole,
+              2e-4 * expectedWhole);
+}
+
+TEST(FinishOutput, FiniteAndNeverBelowZeroOrTheInput) {
+  Image out(4, 1, 1), noisy(4, 1, 1);
+  const float outValues[4] = {kNan, -3.0f, -1.0f, kInf};
+  const float noisyValues[4] = {0.5f, 2.0f, -2.0f, kNan};
+  for (int x = 0; x < 4; ++x) out(x, 0, 0) = outValues[x], noisy(x, 0, 0) = noisyValues[x];
+  finishOutput(out, noisy);
+  EXPECT_EQ(out(0, 0, 0), 0.5f);   // NaN → the noisy value
+  EXPECT_EQ(out(1, 0, 0), 0.0f);   // negative where the input is not → 0
+  EXPECT_EQ(out(2, 0, 0), -1.0f);  // a negative input allows down to itself
+  EXPECT_EQ(out(3, 0, 0), 0.0f);   // Inf and no finite input → 0
+}
+
+TEST(GuardedDenoiser, RegistryMembersKeepTheirNamesAndRequirements) {
+  for (const DenoiserEntry& entry : builtinDenoisers()) {
+    ParamMap none;
+    const auto plain = entry.create(none);
+    const auto guarded = createDenoiser(entry.name);
+    EXPECT_EQ(guarded->name(), plain->name());
+    EXPECT_EQ(guarded->requirements().halves, plain->requirements().halves);
+    EXPECT_EQ(guarded->requirements().features, plain->requirements().features);
+  }
+  EXPECT_THROW(createDenoiser("atrous:guard=-1"), Error);
+}
+
+TEST(OutputValues, RepairsAndCounts) {
+  Image radiance(3, 2, 1);
+  const float values[6] = {kNan, kInf, -kInf, -0.5f, 0.0f, 7.0f};
+  for (int i = 0; i < 6; ++i) radiance.data()[i] = values[i];
+  Image signedCopy = radiance;
+  const OutputRepairs r = repairForOutput(radiance);
+  EXPECT_EQ(r.nonFinite, 3u);
+  EXPECT_EQ(r.negative, 1u);
+  const float expected[6] = {0.0f, kMax, 0.0f, 0.0f, 0.0f, 7.0f};
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(radiance.data()[i], expected[i]) << i;
+  const OutputRepairs s = repairForOutput(signedCopy, true);
+  EXPECT_EQ(s.nonFinite, 3u);
+  EXPECT_EQ(s.negative, 0u);
+  EXPECT_EQ(signedCopy.data()[2], -kMax);
+  EXPECT_EQ(signedCopy.data()[3], -0.5f);
+}
+
+TEST(LocalRange, MatchesBruteForce) {
+  Image image = test::randomImage(13, 9, 2, 7, -1.0f, 1.0f);
+  image(4, 4, 1) = kNan;  // skipped
+  const LocalRange range = localRange(image, 2);
+  for (int y = 0; y < 9; ++y)
+    for (int x = 0; x < 13; ++x)
+      for (int c = 0; c < 2; ++c) {
+        float lo = kInf, hi = -kInf;
+        for (int qy = std::max(0, y - 2); qy <= std::min(8, y + 2); ++qy)
+          for (int qx = std::max(0, x - 2); qx <= std::min(12, x + 2); ++qx)
+            if (std::isfinite(image(qx, qy, c)))
+              lo = std::min(lo, image(qx, qy, c)), hi = std::max(hi, image(qx, qy, c));
+        ASSERT_EQ(range.lo(x, y, c), lo);
+        ASSERT_EQ(range.hi(x, y, c), hi);
+      }
+}
+
+}  // namespace
+}  // namespace chorus

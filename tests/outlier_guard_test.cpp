@@ -1,0 +1,167 @@
+// The outlier guard (denoise/base/outlier_guard.h) on sub-buffers built from explicit samples,
+// so that every expected value is the plain arithmetic of those samples: a lone firefly becomes
+// the mean of the pixel's other samples, a firefly with peers keeps its energy in the window, a
+// value its own samples confirm is kept, ordinary noise is never touched, and the whole is the
+// merge of the guarded halves.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <vector>
+
+#include "denoise/base/outlier_guard.h"
+
+namespace chorus {
+namespace {
+
+using Samples = std::function<std::vector<double>(int x, int y)>;
+
+// A sub-buffer whose grey colour at (x, y) has exactly the given samples (mean, variance of the
+// mean M2 / (n (n − 1)) and count, as the film computes them).
+SubBuffer fromSamples(int w, int h, const Samples& samples) {
+  SubBuffer s = SubBuffer::zeros(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::vector<double> v = samples(x, y);
+      const double n = double(v.size());
+      double mean = 0, m2 = 0;
+      for (double e : v) mean += e / n;
+      for (double e : v) m2 += (e - mean) * (e - mean);
+      for (int c = 0; c < 3; ++c) {
+        s.color.mean(x, y, c) = float(mean);
+        s.color.varianceOfMean(x, y, c) = n >= 2 ? float(m2 / (n * (n - 1))) : 0.0f;
+      }
+      s.sampleCount(x, y, 0) = float(n);
+    }
+  return s;
+}
+
+// Four samples per pixel: 1 ± 0.5 in a fixed pseudo-random pattern.
+std::vector<double> ordinary(int x, int y, uint32_t seed) {
+  std::mt19937 rng(seed + uint32_t(x * 7919 + y * 104729));
+  std::uniform_real_distribution<double> u(0.5, 1.5);
+  return {u(rng), u(rng), u(rng), u(rng)};
+}
+
+DenoiseInput wholeOnly(const SubBuffer& s) {
+  DenoiseInput in;
+  in.whole = s;
+  return in;
+}
+
+double channelSum(const Image& image) {
+  double sum = 0;
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x) sum += image(x, y, 0);
+  return sum;
+}
+
+TEST(OutlierGuard, OrdinaryNoiseIsNeverTouched) {
+  const SubBuffer s = fromSamples(24, 24, [](int x, int y) { return ordinary(x, y, 1); });
+  const GuardedInput g = guardOutliers(wholeOnly(s));
+  EXPECT_EQ(g.clampedValues, 0u);
+  EXPECT_EQ(g.input.whole.color.mean.values().size(), s.color.mean.values().size());
+  for (size_t i = 0; i < s.color.mean.size(); ++i)
+    ASSERT_EQ(g.input.whole.color.mean.data()[i], s.color.mean.data()[i]);
+}
+
+TEST(OutlierGuard, LoneFireflyBecomesTheMeanOfTheOtherSamples) {
+  // Pixel (12, 12): three samples of 1 and one of 1e6. With the other samples alike, the mean
+  // without the largest sample is exactly 1 (withoutLargestSample with the neighbours' spread
+  // subtracted stays within that spread of it).
+  const SubBuffer s = fromSamples(24, 24, [](int x, int y) {
+    if (x == 12 && y == 12) return std::vector<double>{1, 1, 1, 1e6};
+    return ordinary(x, y, 2);
+  });
+  const GuardedInput g = guardOutliers(wholeOnly(s));
+  EXPECT_EQ(g.clampedValues, 3u);  // one per channel
+  EXPECT_NEAR(g.input.whole.color.mean(12, 12, 0), 1.0, 0.3);
+  EXPECT_LT(g.input.whole.color.varianceOfMean(12, 12, 0), 1.0f);
+  // Nothing else moved: the firefly had no peers, so its excess is dropped, not spread.
+  EXPECT_EQ(g.input.whole.color.mean(11, 12, 0), s.color.mean(11, 12, 0));
+}
+
+TEST(OutlierGuard, ConfirmedExcessIsKept) {
+  // A bright pixel whose four samples all agree (a small light seen directly): its own samples
+  // confirm it, however far above its neighbours it is.
+  const SubBuffer s = fromSamples(24, 24, [](int x, int y) {
+    if (x == 5 && y == 9) return std::vector<double>{900, 1000, 1100, 1000};
+    return ordinary(x, y, 3);
+  });
+  EXPECT_EQ(guardOutliers(wholeOnly(s)).clampedValues, 0u);
+}
+
+TEST(OutlierGuard, ManySamplesOfTheTailAreConsistent) {
+  // The same heavy tail (one sample in 8 at 200, the rest at 1) at 8 and at 128 samples per
+  // pixel: at 8 the pixels holding a tail sample stand out and are guarded; at 128 every pixel
+  // holds about 16 of them, its own samples confirm its mean and nothing changes.
+  auto tail = [](int n) {
+    return [n](int x, int y) {
+      std::vector<double> v(size_t(n), 1.0);
+      const int hits = n >= 128 ? n / 8 : ((x * 3 + y * 5) % 17 == 0 ? 1 : 0);
+      for (int i = 0; i < hits; ++i) v[size_t(i)] = 200.0;
+      return v;
+    };
+  };
+  EXPECT_GT(guardOutliers(wholeOnly(fromSamples(32, 32, tail(8)))).clampedValues, 0u);
+  EXPECT_EQ(guardOutliers(wholeOnly(fromSamples(32, 32, tail(128)))).clampedValues, 0u);
+}
+
+TEST(OutlierGuard, FirefliesWithPeersKeepTheirEnergy) {
+  // A caustic: one pixel in 11 of a 16×16 block holds one sample of 300 among four of ~1 (so a
+  // 5×5 neighbourhood holds about two others). Those outliers have peers; their excess is
+  // spread, so the image's sum is kept.
+  const SubBuffer s = fromSamples(40, 40, [](int x, int y) {
+    std::vector<double> v = ordinary(x, y, 4);
+    if (x >= 12 && x < 28 && y >= 12 && y < 28 && (3 * x + 5 * y) % 11 == 0) v[0] = 300.0;
+    return v;
+  });
+  const GuardedInput g = guardOutliers(wholeOnly(s));
+  EXPECT_GT(g.clampedValues, 0u);
+  const double before = channelSum(s.color.mean), after = channelSum(g.input.whole.color.mean);
+  EXPECT_NEAR(after, before, 1e-5 * before);
+  // …and the peaks are gone: no value above a fifth of the firefly's contribution.
+  float largest = 0;
+  for (float v : g.input.whole.color.mean.values()) largest = std::max(largest, v);
+  EXPECT_LT(largest, 0.2f * 300.0f / 4.0f);
+}
+
+TEST(OutlierGuard, TheWholeIsTheMergeOfTheGuardedHalves) {
+  // Half 0 holds a firefly at (7, 7), half 1 does not; both have two samples per pixel.
+  const SubBuffer h0 = fromSamples(20, 20, [](int x, int y) {
+    if (x == 7 && y == 7) return std::vector<double>{1.0, 5e4};
+    return std::vector<double>{ordinary(x, y, 5)[0], ordinary(x, y, 5)[1]};
+  });
+  const SubBuffer h1 = fromSamples(20, 20, [](int x, int y) {
+    return std::vector<double>{ordinary(x, y, 6)[0], ordinary(x, y, 6)[1]};
+  });
+  DenoiseInput in;
+  in.whole = merge({&h0, &h1});
+  in.halves = std::array<SubBuffer, 2>{h0, h1};
+  const GuardedInput g = guardOutliers(in);
+  ASSERT_GT(g.clampedValues, 0u);
+  const SubBuffer expected = merge({&(*g.input.halves)[0], &(*g.input.halves)[1]});
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(g.input.whole.color.mean(7, 7, c), expected.color.mean(7, 7, c), 1e-5);
+    EXPECT_NEAR(g.input.whole.color.varianceOfMean(7, 7, c), expected.color.varianceOfMean(7, 7, c),
+                1e-5);
+  }
+  EXPECT_LT(g.input.whole.color.mean(7, 7, 0), 10.0f);
+  // The other half is judged on its own neighbourhood: untouched.
+  EXPECT_EQ((*g.input.halves)[1].color.mean(7, 7, 0), h1.color.mean(7, 7, 0));
+}
+
+TEST(OutlierGuard, GuardZeroIsOff) {
+  const SubBuffer s = fromSamples(24, 24, [](int x, int y) {
+    if (x == 12 && y == 12) return std::vector<double>{1, 1, 1, 1e6};
+    return ordinary(x, y, 2);
+  });
+  OutlierGuardOptions off;
+  off.ceilingSigmas = 0;
+  EXPECT_EQ(guardOutliers(wholeOnly(s), off).input.whole.color.mean(12, 12, 0),
+            s.color.mean(12, 12, 0));
+}
+
+}  // namespace
+}  // namespace chorus

@@ -1,0 +1,66 @@
+#include "tools/chorus/memory_estimate.h"
+
+#include <algorithm>
+#include <map>
+
+#include "common/memory_budget.h"
+
+namespace chorus::cli {
+
+namespace {
+
+// Calibrated against peak RSS (/usr/bin/time) of cornell-box renders at 4 spp, --threads 2;
+// docs/hardening-cli.md has every run and the command.
+// Process, scene, Embree and TBB: the intercept of 480x270 and 960x540 render-only runs.
+constexpr double kFixedBytes = 40.0 * (1 << 20);
+// Per pixel and sub-buffer while rendering and writing render.exr: the film's 23 float planes
+// (92 bytes) plus the write's buffers (measured 141 at K = 1, 134 per sub-buffer at K = 4).
+constexpr double kRenderBytesPerSubBuffer = 141;
+// The denoisers' inputs: copies of 23 float planes, 9 of them at K = 4 (A, B and full, each
+// with two halves), 5 at K = 2 (no halves in A and B).
+constexpr double kSourceBytesPerCopy = 92;
+// Per pixel, what a member's three runs and the combination add at their peak (the member
+// alone, K = 4, beyond the render and the sources). Peaks of several members did not add up
+// (480x270: nfor alone 338 MiB, nfor,rdfc,atrous 347 MiB, all seven members 328 MiB): the
+// largest counts in full, every further member only its outputs (kFurtherMemberBytes).
+const std::map<std::string, double>& memberPeakBytes() {
+  static const std::map<std::string, double> measured = {
+      {"atrous", 162}, {"bilateral", 212}, {"nlm", 312},  {"sbf", 370},
+      {"jnlm", 389},   {"rdfc", 800},      {"nfor", 1095}};
+  return measured;
+}
+// Full, A and B outputs of a member (3 × RGB float) plus its weight map.
+constexpr double kFurtherMemberBytes = 40;
+
+double memberPeak(const EnsembleMember& member) {
+  const auto& measured = memberPeakBytes();
+  const auto it = measured.find(member.denoiser->name());
+  if (it != measured.end()) return it->second;
+  double largest = 0;  // an unmeasured member: as much as the largest measured one
+  for (const auto& [name, bytes] : measured) largest = std::max(largest, bytes);
+  return largest;
+}
+
+}  // namespace
+
+uint64_t estimatePeakBytes(render::Resolution size, int splits,
+                           std::span<const EnsembleMember> members) {
+  const double pixels = double(size.width) * double(size.height);
+  double perPixel = splits * kRenderBytesPerSubBuffer;
+  if (!members.empty()) {
+    perPixel += (splits == 4 ? 9 : 5) * kSourceBytesPerCopy;
+    double largest = 0;
+    for (const EnsembleMember& member : members) largest = std::max(largest, memberPeak(member));
+    perPixel += largest + double(members.size() - 1) * kFurtherMemberBytes;
+  }
+  return uint64_t(kFixedBytes + pixels * perPixel);
+}
+
+void checkRunMemory(render::Resolution size, int splits, std::span<const EnsembleMember> members) {
+  std::string what = "rendering " + std::to_string(size.width) + "x" + std::to_string(size.height) +
+                     " with " + std::to_string(splits) + " sub-buffer(s)";
+  if (!members.empty()) what += " and " + std::to_string(members.size()) + " denoiser(s)";
+  checkMemoryBudget(estimatePeakBytes(size, splits, members), what);
+}
+
+}  // namespace chorus::cli

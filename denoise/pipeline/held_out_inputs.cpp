@@ -32,11 +32,4 @@ std::vector<DenoiseInput> heldOutInputs(const EnsembleSources& sources) {
   return inputs;
 }
 
-std::vector<Image> quarterColors(const EnsembleSources& sources) {
-  std::vector<Image> colors;
-  if (!hasQuarters(sources)) return colors;
-  for (int k = 0; k < kHeldOutQuarters; ++k) colors.push_back(quarter(sources, k).color.mean);
-  return colors;
-}
-
 }  // namespace chorus

@@ -21,7 +21,4 @@ bool hasQuarters(const EnsembleSources& sources);
 // The four inputs y^(−0) … y^(−3) are computed from. Throws chorus::Error unless hasQuarters.
 std::vector<DenoiseInput> heldOutInputs(const EnsembleSources& sources);
 
-// x_0 … x_3: the colour means of the quarters (empty unless hasQuarters).
-std::vector<Image> quarterColors(const EnsembleSources& sources);
-
 }  // namespace chorus

@@ -11,7 +11,7 @@ namespace chorus::cli {
 
 struct EnsembleFlags {
   std::string solver = "active-set", weightFilter = "bilateral", mseForm = "summed";
-  std::string estimate = MseOptions{}.estimate == MseEstimate::Quarters ? "quarters" : "halves";
+  std::string estimate = estimateName(MseOptions{}.estimate);
   int window = MseOptions{}.windowRadius;
   bool relative = MseOptions{}.relative;
   double outlierCap = MseOptions{}.outlierCap;

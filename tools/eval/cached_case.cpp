@@ -15,6 +15,13 @@ namespace {
 
 const char* const kGuideNames[] = {"color", "colorA", "colorB", "albedo", "normal"};
 
+// "q0", "heldOut3": built by appending (GCC 12 warns falsely on "literal" + std::to_string).
+std::string numbered(const char* prefix, size_t k) {
+  std::string name = prefix;
+  name += std::to_string(k);
+  return name;
+}
+
 Image layer(const std::vector<ExrLayer>& layers, const std::string& name, const fs::path& file) {
   const ExrLayer* found = findLayer(layers, name);
   if (!found) throw fileError(file, "has no layer '" + name + "'");
@@ -40,7 +47,7 @@ void writeCachedGuides(const fs::path& dir, const EnsembleGuides& guides) {
   std::vector<ExrLayer> layers;
   for (size_t i = 0; i < 5; ++i) layers.push_back({kGuideNames[i], *images[i]});
   for (size_t k = 0; k < guides.quarters.size(); ++k)
-    layers.push_back({"q" + std::to_string(k), guides.quarters[k]});
+    layers.push_back({numbered("q", size_t(k)), guides.quarters[k]});
   ensureDirectory(dir);
   writeExr(cachedGuidesPath(dir), layers);
 }
@@ -51,8 +58,8 @@ EnsembleGuides readCachedGuides(const fs::path& dir) {
   EnsembleGuides g;
   Image* images[] = {&g.color, &g.colorA, &g.colorB, &g.albedo, &g.normal};
   for (size_t i = 0; i < 5; ++i) *images[i] = layer(layers, kGuideNames[i], file);
-  for (int k = 0; findLayer(layers, "q" + std::to_string(k)); ++k)
-    g.quarters.push_back(layer(layers, "q" + std::to_string(k), file));
+  for (int k = 0; findLayer(layers, numbered("q", size_t(k))); ++k)
+    g.quarters.push_back(layer(layers, numbered("q", size_t(k)), file));
   return g;
 }
 
@@ -60,7 +67,7 @@ void writeCachedMember(const fs::path& dir, const BaseOutputs& outputs,
                        std::span<const double> seconds) {
   std::vector<ExrLayer> layers = {{"A", outputs.a}, {"B", outputs.b}, {"full", outputs.full}};
   for (size_t k = 0; k < outputs.heldOut.size(); ++k)
-    layers.push_back({"heldOut" + std::to_string(k), outputs.heldOut[k]});
+    layers.push_back({numbered("heldOut", size_t(k)), outputs.heldOut[k]});
   const fs::path file = cachedMemberPath(dir, outputs.name);
   ensureDirectory(file.parent_path());
   std::ostringstream times;
@@ -78,8 +85,8 @@ BaseOutputs readCachedMember(const fs::path& dir, const std::string& spec) {
   o.a = layer(layers, "A", file);
   o.b = layer(layers, "B", file);
   o.full = layer(layers, "full", file);
-  for (int k = 0; findLayer(layers, "heldOut" + std::to_string(k)); ++k)
-    o.heldOut.push_back(layer(layers, "heldOut" + std::to_string(k), file));
+  for (int k = 0; findLayer(layers, numbered("heldOut", size_t(k))); ++k)
+    o.heldOut.push_back(layer(layers, numbered("heldOut", size_t(k)), file));
   return o;
 }
 

@@ -9,7 +9,6 @@
 //   DIR/members/<m>.tsv  the seconds of each of those runs
 //
 // Members already cached are kept (a rerun adds only missing members).
-#include <tbb/task_group.h>
 #include <CLI/CLI.hpp>
 
 #include <filesystem>
@@ -22,12 +21,10 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/image/exr_io.h"
-#include "common/stopwatch.h"
 #include "common/thread_limit.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/buffers_exr.h"
 #include "denoise/pipeline/ensemble.h"
-#include "denoise/pipeline/held_out_inputs.h"
 #include "tests/support/synthetic_cases.h"
 #include "tools/eval/cached_case.h"
 
@@ -89,42 +86,22 @@ void run(const Args& args) {
     throw fileError(renderFile, "has " + std::to_string(buffers.splitCount()) +
                                     " sub-buffers; the cache needs 4");
   const EnsembleSources sources = sourcesFromBuffers(buffers);
-  EnsembleGuides guides = guidesFromSources(sources);
-  guides.quarters = quarterColors(sources);
+  const EnsembleGuides guides = guidesFromSources(sources, true);
   if (!fs::exists(cachedGuidesPath(dir))) writeCachedGuides(dir, guides);
 
-  const std::vector<DenoiseInput> heldOut = heldOutInputs(sources);
-  std::vector<const DenoiseInput*> inputs = {&sources.a, &sources.b, &sources.full};
-  for (const DenoiseInput& in : heldOut) inputs.push_back(&in);
   const std::vector<std::string> specs = splitMethodList(args.methods);
-  std::vector<std::string> pending;
+  std::vector<EnsembleMember> pending;
   for (const std::string& spec : specs)
-    if (!fs::exists(cachedMemberPath(dir, spec))) pending.push_back(spec);
-  const size_t parts = inputs.size();
-  std::vector<BaseOutputs> outputs(pending.size());
-  std::vector<double> seconds(pending.size() * parts);
-  tbb::task_group group;
-  for (size_t m = 0; m < pending.size(); ++m) {
-    const std::shared_ptr<const BaseDenoiser> denoiser = memberDenoiser(pending[m]);
-    outputs[m].name = pending[m];
-    outputs[m].heldOut.resize(heldOut.size());
-    for (size_t part = 0; part < parts; ++part)
-      group.run([&, m, part, denoiser] {
-        const Stopwatch clock;
-        Image out = denoiser->run(*inputs[part]);
-        seconds[m * parts + part] = clock.seconds();
-        BaseOutputs& o = outputs[m];
-        (part == 0   ? o.a
-         : part == 1 ? o.b
-         : part == 2 ? o.full
-                     : o.heldOut[part - 3]) = std::move(out);
-      });
-  }
-  group.wait();
-  for (size_t m = 0; m < pending.size(); ++m) {
-    std::vector<double> times(seconds.begin() + long(m * parts),
-                              seconds.begin() + long((m + 1) * parts));
-    writeCachedMember(dir, outputs[m], times);
+    if (!fs::exists(cachedMemberPath(dir, spec))) pending.push_back({spec, memberDenoiser(spec)});
+  if (!pending.empty()) {
+    std::vector<StageTime> times;
+    const std::vector<BaseOutputs> outputs = runBaseDenoisers(sources, pending, &times, true);
+    for (const BaseOutputs& o : outputs) {
+      std::vector<double> seconds;
+      for (const StageTime& t : times)
+        if (t.stage.rfind(o.name + "/", 0) == 0) seconds.push_back(t.seconds);
+      writeCachedMember(dir, o, seconds);
+    }
   }
   std::cerr << "ensemble_cache: " << dir.string() << ": " << pending.size() << " member(s) run, "
             << specs.size() - pending.size() << " cached\n";

@@ -246,12 +246,15 @@ def print_per_combination(cases, combos, out):
 
 def print_cases(cases, combo, out):
     chosen = [c for c in cases if c["combo"] == combo]
-    out.write("\nPer scene and spp, %s (relMSE; ratio = ensemble / best member)\n\n" % combo)
-    out.write("| scene | spp | best member | its relMSE | ensemble | ratio | one-hot pre | "
-              "one-hot post | oracle |\n|---|---|---|---|---|---|---|---|---|\n")
+    out.write("\nPer scene and spp, %s (relMSE; ratio = ensemble / best member; DSSIM: the "
+              "least of the members' and the ensemble's)\n\n" % combo)
+    out.write("| scene | spp | best member | its relMSE | ensemble | ratio | members' DSSIM | "
+              "ensemble DSSIM | one-hot pre | one-hot post | oracle |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|\n")
     for c in sorted(chosen, key=lambda c: (c["scene"], c["spp"])):
-        out.write("| %s | %d | %s | %.4g | %.4g | %.3f | %s | %s | %s |\n" % (
+        out.write("| %s | %d | %s | %.4g | %.4g | %.3f | %.4f | %.4f | %s | %s | %s |\n" % (
             c["scene"], c["spp"], c["best_name"], c["best"], c["ensemble"], ratio(c),
+            c["best_dssim"], c["ensemble_dssim"],
             *("%.4g" % c[k] if c[k] is not None else "–"
               for k in ("onehot-pre", "onehot-post", "oracle"))))
 

@@ -520,7 +520,8 @@ TEST(MseEstimate, FireflyHalfRevealsTheBaseThatPassedItThrough) {
 // is computed here from the definition and checked just inside and just outside.
 TEST(MseEstimate, NoBasePlausibleWhereEveryBaseIsFarFromBothHalves) {
   Fixture f = makeFixture(12, 10, 10);
-  const MseOptions defaults;
+  MseOptions defaults;
+  defaults.noisyFallback = 10;  // off by default
   const int x = 5, y = 3, width = 12;
   {
     const MseEstimator estimator(f.guides, pointers(f), defaults);

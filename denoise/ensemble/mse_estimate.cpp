@@ -21,16 +21,22 @@ constexpr int kPriorBandRows = 32;
 
 // The trace of a packed symmetric n × n matrix on the tangent space {Σv = 0}: tr H − 1ᵀH1/n,
 // the part of H the solve sees. entry(k) = the k-th packed entry.
+// Over the bases of `mask` only (the sub-matrix the solve sees where the others are missing).
 template <typename Entry>
-double tangentTrace(int n, const Entry& entry) {
+double tangentTrace(int n, BaseMask mask, const Entry& entry) {
   double trace = 0, total = 0;
-  for (int i = 0, k = 0; i < n; ++i)
+  int count = 0;
+  for (int i = 0, k = 0; i < n; ++i) {
+    const bool inI = (mask >> i) & 1u;
+    count += inI;
     for (int j = i; j < n; ++j, ++k) {
+      if (!inI || !((mask >> j) & 1u)) continue;
       const double v = entry(k);
       trace += i == j ? v : 0.0;
       total += i == j ? v : 2.0 * v;
     }
-  return trace - total / n;
+  }
+  return count > 0 ? trace - total / count : 0.0;
 }
 
 bool finite3(const float* v) {
@@ -114,11 +120,9 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
   if (!(options.memberFallback == 0 || options.memberFallback >= 1) ||
       !std::isfinite(options.memberFallback))
     throw Error("the member fallback's factor must be 0 (off) or a finite number ≥ 1");
-  const bool quarters = options.estimate != MseEstimate::Halves && !reference;
-  if (quarters && (guides.quarters.size() != 4 || bases[0]->heldOut.size() != 4))
-    throw Error(
-        "the leave-one-quarter-out estimate needs the noisy quarters and every member's four "
-        "held-out runs (K = 4 sub-buffers)");
+  // Inputs without quarters (K = 2, an outputs directory) use the halves.
+  const bool quarters = options.estimate != MseEstimate::Halves && !reference &&
+                        guides.quarters.size() == 4 && bases[0]->heldOut.size() == 4;
   width_ = guides.width();
   height_ = guides.height();
   baseCount_ = int(bases.size());
@@ -139,7 +143,7 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
       heldOut.push_back(fold);
     }
   folds_ = quarters ? heldOut : halves;
-  if (options.estimate == MseEstimate::Extrapolated && !reference) {
+  if (options.estimate == MseEstimate::Extrapolated && quarters) {
     // e(s) = a + b/s at s = ½, ¾ and 1 of the samples: e(1) = 1.5 e(¾) − 0.5 e(½).
     primaryWeight_ = 1.5;
     secondaryFolds_ = halves;
@@ -175,39 +179,51 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
 }
 
 std::vector<double> MseEstimator::imagePriorTerms() const {
-  // Bands in parallel, summed in band order (the same result for any thread count).
+  // Bands in parallel, summed in band order (the same result for any thread count). Each entry
+  // is the mean over the pixels where its bases are both present (a base missing over a region
+  // changes nothing in the other bases' entries).
   const int bands = (height_ + kPriorBandRows - 1) / kPriorBandRows;
+  const int n = baseCount_, entries = this->entries();
   std::vector<std::vector<double>> sums(static_cast<size_t>(bands));
-  std::vector<size_t> counts(static_cast<size_t>(bands), 0);
+  std::vector<std::vector<size_t>> counts(static_cast<size_t>(bands));
   tbb::parallel_for(0, bands, [&](int band) {
     const int y0 = band * kPriorBandRows, y1 = std::min(height_, y0 + kPriorBandRows);
     std::vector<float> planes;
     // Relative to μ̂² + (mean |x| / 2)²: every region counts by its relative error, as in
     // relMSE, but with a knee that follows the image's brightness, not its unit.
-    const std::vector<char> complete = pixelTerms(y0, y1, planes, 0.25 * scale_ * scale_);
-    const size_t pixels = complete.size();
+    const std::vector<BaseMask> present = pixelTerms(y0, y1, planes, 0.25 * scale_ * scale_);
+    const size_t pixels = present.size();
     std::vector<double>& sum = sums[size_t(band)];
+    std::vector<size_t>& count = counts[size_t(band)];
     sum.assign(size_t(planeCount()), 0.0);
+    count.assign(size_t(entries + 1), 0);
     for (size_t p = 0; p < pixels; ++p) {
-      if (!complete[p]) continue;
-      ++counts[size_t(band)];
-      for (int k = 0; k < planeCount(); ++k) sum[size_t(k)] += planes[size_t(k) * pixels + p];
+      const BaseMask mask = present[p];
+      if (mask == 0) continue;
+      for (int i = 0, k = 0; i < n; ++i)
+        for (int j = i; j < n; ++j, ++k) {
+          if (!((mask >> i) & 1u) || !((mask >> j) & 1u)) continue;
+          ++count[size_t(k)];
+          for (int g = 0; g < groups(); ++g)
+            sum[size_t(g * (entries + 1) + k)] +=
+                planes[size_t(g * (entries + 1) + k) * pixels + p];
+        }
     }
   });
   std::vector<double> mean(size_t(planeCount()), 0.0);
-  size_t count = 0;
+  std::vector<size_t> count(size_t(entries + 1), 0);
   for (int band = 0; band < bands; ++band) {
-    count += counts[size_t(band)];
+    for (int k = 0; k < entries; ++k) count[size_t(k)] += counts[size_t(band)][size_t(k)];
     for (int k = 0; k < planeCount(); ++k) mean[size_t(k)] += sums[size_t(band)][size_t(k)];
   }
-  if (count == 0) return {};
-  // Per group, divided by its tangent trace (a group without one adds nothing).
-  const int n = baseCount_, entries = this->entries();
-  for (int g = 0; g < groups(); ++g) {
-    double* group = mean.data() + size_t(g * (entries + 1));
-    const double trace = tangentTrace(n, [&](int k) { return group[k]; });
-    for (int k = 0; k < entries; ++k) group[k] = trace > 0 ? group[k] / trace : 0.0;
-  }
+  bool any = false;
+  for (int g = 0; g < groups(); ++g)
+    for (int k = 0; k < entries; ++k) {
+      double& v = mean[size_t(g * (entries + 1) + k)];
+      v = count[size_t(k)] > 0 ? v / double(count[size_t(k)]) : 0.0;
+      any = any || count[size_t(k)] > 0;
+    }
+  if (!any) return {};
   return mean;
 }
 
@@ -215,13 +231,19 @@ void MseEstimator::addImagePrior(MseRows& rows) const {
   if (imagePrior_.empty()) return;
   const int n = baseCount_, entries = this->entries();
   const size_t pixels = size_t(rows.y1_ - rows.y0_) * size_t(width_);
-  for (int g = 0; g < groups(); ++g) {
-    const double* prior = imagePrior_.data() + size_t(g * (entries + 1));
-    for (size_t p = 0; p < pixels; ++p) {
+  for (size_t p = 0; p < pixels; ++p) {
+    // Both traces over the bases present at the pixel: the prior and the local evidence are
+    // compared on the sub-matrix the solve sees there.
+    const BaseMask mask = validAt(size_t(rows.y0_) * size_t(width_) + p);
+    for (int g = 0; g < groups(); ++g) {
+      const double* prior = imagePrior_.data() + size_t(g * (entries + 1));
+      const double priorTrace = tangentTrace(n, mask, [&](int k) { return prior[k]; });
+      if (!(priorTrace > 0)) continue;
       float* h = rows.planes_.data() + size_t(g * (entries + 1)) * pixels + p;
-      const double local = tangentTrace(n, [&](int k) { return double(h[size_t(k) * pixels]); });
-      // No local evidence (no complete pixel in the window): the prior alone.
-      const double factor = local > 0 ? options_.imagePrior * local : 1.0;
+      const double local =
+          tangentTrace(n, mask, [&](int k) { return double(h[size_t(k) * pixels]); });
+      // No local evidence (no pixel with these bases in the window): the prior alone.
+      const double factor = (local > 0 ? options_.imagePrior * local : 1.0) / priorTrace;
       for (int k = 0; k < entries; ++k) h[size_t(k) * pixels] += float(factor * prior[k]);
     }
   }
@@ -420,14 +442,13 @@ BaseMask MseEstimator::plausibleBases(BaseMask mask, const FoldTerms& t) const {
   return inEveryFold != 0 ? inEveryFold : plausible;
 }
 
-std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes,
-                                           double relativeEpsilon) const {
+std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes,
+                                               double relativeEpsilon) const {
   const bool relative = relativeEpsilon >= 0;
   const int n = baseCount_, entries = this->entries();
   const size_t pixels = size_t(y1 - y0) * size_t(width_);
   planes.assign(size_t(planeCount()) * pixels, 0.0f);
-  std::vector<char> complete(pixels, 0);
-  const BaseMask all = allBases(n);
+  std::vector<BaseMask> present(pixels, 0);
   std::array<double, 3 * ((kMaxDenoisers * (kMaxDenoisers + 1)) / 2 + 1)> acc{};
   std::array<double, kMaxDenoisers> first{};
   for (size_t local = 0; local < pixels; ++local) {
@@ -492,9 +513,9 @@ std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& p
     if (!finite) continue;
     for (int k = 0; k < planeCount(); ++k)
       planes[size_t(k) * pixels + local] = float(acc[size_t(k)]);
-    complete[local] = valid == all;
+    present[local] = valid;
   }
-  return complete;
+  return present;
 }
 
 MseRows MseEstimator::rows(int y0, int y1) const {
@@ -523,23 +544,55 @@ MseRows MseEstimator::rows(int y0, int y1) const {
     addImagePrior(out);
     return out;
   }
-  // Per-pixel terms of the rows the window reaches; pixels with a non-finite input are left
-  // out of every window; then the joint-bilateral window.
+  // Per-pixel terms of the rows the window reaches, then the joint-bilateral window. A pixel
+  // where some bases are missing (non-finite) still adds the entries of the bases present;
+  // where any is missing, presence planes (1 where base i is present, 1 where the pixel has
+  // terms at all) are filtered alongside, and entry (i, j) is divided by the window's share of
+  // pixels with both present: the window's mean over the pixels that have the entry (exact
+  // where one base has holes, an approximation where several have different ones).
   const int inY0 = std::max(0, y0 - r), inY1 = std::min(height_, y1 + r);
   std::vector<float> in;
-  const std::vector<char> complete = pixelTerms(inY0, inY1, in, objectiveEpsilon());
+  const std::vector<BaseMask> present = pixelTerms(inY0, inY1, in, objectiveEpsilon());
   const size_t inPixels = size_t(inY1 - inY0) * size_t(width_);
-  for (size_t local = 0; local < inPixels; ++local)
-    if (!complete[local])
-      for (int k = 0; k < planeCount(); ++k) in[size_t(k) * inPixels + local] = 0.0f;
+  const BaseMask all = allBases(baseCount_);
+  const bool holes =
+      std::any_of(present.begin(), present.end(), [&](BaseMask m) { return m != 0 && m != all; });
+  const int presencePlanes = holes ? baseCount_ + 1 : 0;
+  if (holes) {
+    in.resize(size_t(planeCount() + presencePlanes) * inPixels, 0.0f);
+    float* presence = in.data() + size_t(planeCount()) * inPixels;
+    for (size_t local = 0; local < inPixels; ++local) {
+      if (present[local] == 0) continue;
+      presence[local] = 1.0f;
+      for (int i = 0; i < baseCount_; ++i)
+        if ((present[local] >> i) & 1u) presence[size_t(i + 1) * inPixels + local] = 1.0f;
+    }
+  }
   out.planes_.assign(size_t(planeCount()) * pixels, 0.0f);
+  std::vector<float> outPresence(size_t(presencePlanes) * pixels);
   std::vector<const float*> inPlanes;
   std::vector<float*> outPlanes;
-  for (int k = 0; k < planeCount(); ++k) {
+  for (int k = 0; k < planeCount() + presencePlanes; ++k) {
     inPlanes.push_back(in.data() + size_t(k) * inPixels);
-    outPlanes.push_back(out.planes_.data() + size_t(k) * pixels);
+    outPlanes.push_back(k < planeCount() ? out.planes_.data() + size_t(k) * pixels
+                                         : outPresence.data() + size_t(k - planeCount()) * pixels);
   }
   filterPlaneRows(windowGuides_, windowKernel_, inPlanes, inY0, y0, y1, outPlanes);
+  if (holes) {
+    const int n = baseCount_, entries = this->entries();
+    for (size_t p = 0; p < pixels; ++p) {
+      const float any = outPresence[p];
+      for (int i = 0, k = 0; i < n; ++i)
+        for (int j = i; j < n; ++j, ++k) {
+          const float share = std::min(outPresence[size_t(i + 1) * pixels + p],
+                                       outPresence[size_t(j + 1) * pixels + p]);
+          for (int g = 0; g < groups(); ++g) {
+            float& v = out.planes_[size_t(g * (entries + 1) + k) * pixels + p];
+            v = share > 0 ? v * (any / share) : 0.0f;
+          }
+        }
+    }
+  }
   addImagePrior(out);
   return out;
 }

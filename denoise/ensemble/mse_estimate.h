@@ -59,16 +59,22 @@
 //   blend that is best over the whole image: a window holds ~100 pixels whose noisy halves, at
 //   a few samples per pixel, cannot rank bases that differ by less than their noise, while the
 //   image-wide mean can; where one base is clearly better locally its H still decides. A pixel
-//   whose window holds no complete pixel gets Ḡ alone. Not applied to the oracle.
+//   whose window holds no pixel with its bases gets Ḡ alone. Not applied to the oracle.
 // - noisyFallback K (0 = off, else ≥ 1; applied by the ensemble combiner): where even the best
 //   base's d_i exceeds K²·(½ Σ_c (x^A − x^B)² + Σ_c (0.1·(mean |x| + |x̄|))²), the result is the
 //   noisy full-buffer value. Every base then spread energy into the pixel that neither half
 //   shows (a lamp's bulb smeared onto the black pixel beside it: LightsPunctualLamp, 128 spp,
 //   rdfc 22 and sbf 3.5 where the reference is 0.03 and all four sub-buffers 0.0001), and no
-//   blend of them can be right; the pixel's own samples can.
-// Non-finite inputs: a base whose output (A, B or full) is NaN/Inf at a pixel is invalid there
-// (its bit in `valid` is 0; the solver gives it weight 0). A pixel where any base or x^A/x^B is
-// non-finite contributes nothing to its neighbours' windows.
+//   blend of them can be right; the pixel's own samples can. Off by default (issue 25): where
+//   the noisy value is the implausible one (a few samples per pixel of a light reached through
+//   one bounce: both halves 0, every member lit from the neighbours) it made black speckle, and
+//   it lost on the evaluation corpus (docs/ensemble-quality.md).
+// Non-finite inputs: a base whose output (any run) is NaN/Inf at a pixel is invalid there (its
+// bit in `valid` is 0; the solver gives it weight 0). The pixel still adds the entries of the
+// other bases to its neighbours' windows, and each windowed entry is the mean over the pixels
+// where both its bases are present (issue 26: one bad member changes nothing where the others
+// are fine); the image prior's entries likewise, and its scale is taken over the bases present
+// at each pixel. A pixel whose noisy comparators are non-finite adds nothing.
 #include <array>
 #include <limits>
 #include <span>
@@ -93,18 +99,25 @@ enum class MseForm { PerChannel, Summed };
 // - Extrapolated: 1.5 × the quarters' estimate − 0.5 × the halves' (an error that falls as
 //   a + b/s with the share s of the samples, extrapolated from s = ½ and ¾ to 1). Not unbiased
 //   for any run's error; may be indefinite (the solver then finds a feasible local minimiser).
+// Quarters and Extrapolated fall back to Halves where the inputs have no quarters and held-out
+// runs (K = 2 renders, a directory of outputs).
 enum class MseEstimate { Halves, Quarters, Extrapolated };
+inline const char* estimateName(MseEstimate e) {
+  return e == MseEstimate::Halves     ? "halves"
+         : e == MseEstimate::Quarters ? "quarters"
+                                      : "extrapolated";
+}
 
 struct MseOptions {
   MseForm form = MseForm::Summed;
-  MseEstimate estimate = MseEstimate::Halves;
+  MseEstimate estimate = MseEstimate::Quarters;
   int windowRadius = 5;
   bool relative = false;
   double outlierCap = 30.0;
   double consistency = 4.0;
   double plausibility = 4.0;
   double imagePrior = 0.3;
-  double noisyFallback = 10.0;
+  double noisyFallback = 0.0;
   double memberFallback = 0.0;
   float windowSigmaSpatial = 0;  // σ_s in pixels; 0 = the window radius
   float windowSigmaNormal = 0.2f;
@@ -184,14 +197,14 @@ class MseEstimator {
  private:
   MseEstimator(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,
                const MseOptions& options, const Image* reference);
-  // Per-pixel (unwindowed) planes for rows [y0, y1); returns per pixel whether every base and
-  // the noisy halves were finite (only such pixels may enter a neighbour's window).
+  // Per-pixel (unwindowed) planes for rows [y0, y1); returns per pixel the bases whose entries
+  // it holds (finite there; 0: the pixel holds nothing, e.g. a non-finite noisy comparator).
   // relativeEpsilon < 0: absolute units (divided by scale²); else divided by μ̂² + relativeEpsilon.
-  std::vector<char> pixelTerms(int y0, int y1, std::vector<float>& planes,
-                               double relativeEpsilon) const;
+  std::vector<BaseMask> pixelTerms(int y0, int y1, std::vector<float>& planes,
+                                   double relativeEpsilon) const;
   double objectiveEpsilon() const;
-  // The mean of the relative per-pixel terms over the complete pixels, per group divided by its
-  // tangent trace (empty when no pixel is complete).
+  // The mean of the relative per-pixel terms, each entry over the pixels where both its bases
+  // are present (empty when no pixel has any); addImagePrior scales it per pixel.
   std::vector<double> imagePriorTerms() const;
   // H += imagePrior · (tangent trace of H) · imagePrior_, per pixel of `rows`.
   void addImagePrior(MseRows& rows) const;

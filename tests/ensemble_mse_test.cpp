@@ -45,8 +45,10 @@ struct Fixture {
   Image truth;
 };
 
-// A smooth truth with an edge, halves with independent noise, three bases per half.
-Fixture makeFixture(int w, int h, uint64_t seed, float noise = 0.3f) {
+// A smooth truth with an edge, halves with independent noise, three bases run on half A, half
+// B and the full buffer. With `quarters`, the halves are the means of two quarters each (noise
+// √2 times the halves'), and the bases also run on every three of the four (held-out runs).
+Fixture makeFixture(int w, int h, uint64_t seed, float noise = 0.3f, bool quarters = false) {
   Fixture f;
   f.truth = Image(w, h, 3);
   for (int y = 0; y < h; ++y)
@@ -54,14 +56,31 @@ Fixture makeFixture(int w, int h, uint64_t seed, float noise = 0.3f) {
       for (int c = 0; c < 3; ++c)
         f.truth(x, y, c) = 0.5f + 0.1f * c + (x > w / 2 ? 0.8f : 0.0f) + 0.02f * y;
   std::mt19937_64 rng(seed);
-  std::normal_distribution<float> gauss(0.0f, noise);
-  f.guides.colorA = f.truth;
-  f.guides.colorB = f.truth;
-  for (float& v : f.guides.colorA.values()) v += gauss(rng);
-  for (float& v : f.guides.colorB.values()) v += gauss(rng);
-  f.guides.color = f.truth;
-  for (size_t e = 0; e < f.truth.size(); ++e)
-    f.guides.color.data()[e] = 0.5f * (f.guides.colorA.data()[e] + f.guides.colorB.data()[e]);
+  const auto noisy = [&](float sigma) {
+    std::normal_distribution<float> gauss(0.0f, sigma);
+    Image out = f.truth;
+    for (float& v : out.values()) v += gauss(rng);
+    return out;
+  };
+  const auto mean = [](std::vector<const Image*> images) {
+    Image out = *images[0];
+    for (size_t e = 0; e < out.size(); ++e) {
+      double sum = 0;
+      for (const Image* image : images) sum += image->data()[e];
+      out.data()[e] = float(sum / double(images.size()));
+    }
+    return out;
+  };
+  if (quarters) {
+    for (int k = 0; k < 4; ++k) f.guides.quarters.push_back(noisy(noise * std::sqrt(2.0f)));
+    const std::vector<Image>& q = f.guides.quarters;
+    f.guides.colorA = mean({&q[0], &q[1]});
+    f.guides.colorB = mean({&q[2], &q[3]});
+  } else {
+    f.guides.colorA = noisy(noise);
+    f.guides.colorB = noisy(noise);
+  }
+  f.guides.color = mean({&f.guides.colorA, &f.guides.colorB});
   f.guides.albedo = Image(w, h, 3, 0.5f);
   f.guides.normal = Image(w, h, 3);
   for (int y = 0; y < h; ++y)
@@ -70,7 +89,16 @@ Fixture makeFixture(int w, int h, uint64_t seed, float noise = 0.3f) {
       for (int c = 0; c < 3; ++c) f.guides.albedo(x, y, c) = x > w / 2 ? 0.8f : 0.3f;
     }
   const auto run = [&](const std::string& name, auto fn) {
-    f.bases.push_back({name, fn(f.guides.colorA), fn(f.guides.colorB), fn(f.guides.color)});
+    BaseOutputs b{name, fn(f.guides.colorA), fn(f.guides.colorB), fn(f.guides.color), {}};
+    const std::vector<Image>& q = f.guides.quarters;
+    if (quarters)
+      for (int k = 0; k < 4; ++k) {
+        std::vector<const Image*> others;
+        for (int j = 0; j < 4; ++j)
+          if (j != k) others.push_back(&q[size_t(j)]);
+        b.heldOut.push_back(fn(mean(others)));
+      }
+    f.bases.push_back(std::move(b));
   };
   run("box1", [](const Image& in) { return boxBlur(in, 1); });
   run("box3", [](const Image& in) { return boxBlur(in, 3); });
@@ -201,17 +229,27 @@ TEST(MseEstimate, MatchesTheDefinition) {
         }
 }
 
-// Image mean over pixels of ⟨M⟩ − T, per entry, with T the true half-buffer error matrix
-// ½((y^A − μ)(y^A − μ)ᵀ + (y^B − μ)(y^B − μ)ᵀ) averaged over the same window (the windowed
-// estimate is unbiased for the window's average error, not for the centre pixel's).
+// Image mean over pixels of ⟨M⟩ − T, per entry, with T the true error matrix of the runs the
+// estimate judges, averaged over the same window (the windowed estimate is unbiased for the
+// window's average error, not for the centre pixel's): for the halves
+// ½((y^A − μ)(y^A − μ)ᵀ + (y^B − μ)(y^B − μ)ᵀ), for the quarters ¼ Σ_k (y^(−k) − μ)(y^(−k) − μ)ᵀ.
 std::vector<double> meanDeviation(const Fixture& f, const MseOptions& o) {
   const MseEstimator estimator(f.guides, pointers(f), o);
   const int n = 3, w = f.truth.width(), h = f.truth.height(), r = o.windowRadius;
+  std::vector<std::vector<const Image*>> runs(static_cast<size_t>(n));  // per base, runs judged
+  for (int i = 0; i < n; ++i) {
+    const BaseOutputs& b = f.bases[size_t(i)];
+    if (o.estimate == MseEstimate::Quarters)
+      for (const Image& run : b.heldOut) runs[size_t(i)].push_back(&run);
+    else
+      runs[size_t(i)] = {&b.a, &b.b};
+  }
   const auto trueEntry = [&](int x, int y, int c, int i, int j) {
     const double mu = f.truth(x, y, c);
-    const double a = (f.bases[size_t(i)].a(x, y, c) - mu) * (f.bases[size_t(j)].a(x, y, c) - mu);
-    const double b = (f.bases[size_t(i)].b(x, y, c) - mu) * (f.bases[size_t(j)].b(x, y, c) - mu);
-    return 0.5 * (a + b);
+    double sum = 0;
+    for (size_t k = 0; k < runs[size_t(i)].size(); ++k)
+      sum += ((*runs[size_t(i)][k])(x, y, c) - mu) * ((*runs[size_t(j)][k])(x, y, c) - mu);
+    return sum / double(runs[size_t(i)].size());
   };
   std::vector<double> sum(size_t(n * n), 0.0);
   const MseRows rows = estimator.rows(0, h);
@@ -239,9 +277,11 @@ std::vector<double> meanDeviation(const Fixture& f, const MseOptions& o) {
 struct BiasCheck {
   double worstZ = 0;  // largest |mean| / standard error over the entries
 };
-BiasCheck biasOverSeeds(int radius, bool leaky) {
+BiasCheck biasOverSeeds(int radius, bool leaky, MseEstimate estimate = MseEstimate::Halves) {
   constexpr int kSeeds = 300;
+  const bool quarters = estimate == MseEstimate::Quarters;
   MseOptions o;
+  o.estimate = estimate;
   o.form = MseForm::PerChannel;
   o.windowRadius = radius;
   // The outlier cap weighs pixels by their own noisy terms, which trades a bias for robustness
@@ -251,8 +291,13 @@ BiasCheck biasOverSeeds(int radius, bool leaky) {
   o.imagePrior = 0;
   std::vector<double> sum(9, 0.0), sumSq(9, 0.0);
   for (int s = 0; s < kSeeds; ++s) {
-    Fixture f = makeFixture(16, 12, 1000 + uint64_t(s));
-    if (leaky) {
+    Fixture f = makeFixture(16, 12, 1000 + uint64_t(s), 0.3f, quarters);
+    if (leaky && quarters) {
+      // The premise broken: each held-out run is the run on all four quarters, so it saw the
+      // quarter it is compared with.
+      for (BaseOutputs& b : f.bases)
+        for (Image& run : b.heldOut) run = b.full;
+    } else if (leaky) {
       // The estimator's premise broken: the "other half" is the same half, so x^B is not
       // independent of y^A. The test must notice.
       f.guides.colorB = f.guides.colorA;
@@ -277,6 +322,16 @@ TEST(MseEstimate, UnbiasedForTheHalfBufferErrorMatrix) {
   for (int radius : {0, 2}) EXPECT_LT(biasOverSeeds(radius, false).worstZ, 3.0) << radius;
   // Negative control: the same statistic detects the bias of a leaky estimator.
   EXPECT_GT(biasOverSeeds(0, true).worstZ, 10.0);
+}
+
+TEST(MseEstimate, LeaveOneQuarterOutIsUnbiasedForTheThreeQuarterRuns) {
+  // ⟨M⟩ = H + c·11ᵀ from the held-out runs and quarters (c from the quarters' spread): the mean
+  // over 300 seeds of its deviation from the held-out runs' true error matrix is within 3
+  // standard errors of 0, per pixel and windowed.
+  for (int radius : {0, 2})
+    EXPECT_LT(biasOverSeeds(radius, false, MseEstimate::Quarters).worstZ, 3.0) << radius;
+  // Negative control: held-out runs that saw their quarter.
+  EXPECT_GT(biasOverSeeds(0, true, MseEstimate::Quarters).worstZ, 10.0);
 }
 
 TEST(MseEstimate, OracleIsTheTrueErrorMatrix) {
@@ -465,7 +520,8 @@ TEST(MseEstimate, FireflyHalfRevealsTheBaseThatPassedItThrough) {
 // is computed here from the definition and checked just inside and just outside.
 TEST(MseEstimate, NoBasePlausibleWhereEveryBaseIsFarFromBothHalves) {
   Fixture f = makeFixture(12, 10, 10);
-  const MseOptions defaults;
+  MseOptions defaults;
+  defaults.noisyFallback = 10;  // off by default
   const int x = 5, y = 3, width = 12;
   {
     const MseEstimator estimator(f.guides, pointers(f), defaults);

@@ -7,6 +7,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "common/error.h"
 #include "common/stopwatch.h"
@@ -237,12 +238,13 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
 
   std::vector<BaseMask> valid;
   std::vector<char> fallback;  // ensemble only: the noisy value replaces the blend there
+  std::optional<MseEstimator> ensembleEstimator;
   bool nonNegative = true, filter = options.filter.enabled;
   // onehot-pre filters the MSE maps, not the weights, and times its own stages.
   const bool filtersBeforeChoosing = options.combiner == Combiner::OnehotPre;
   switch (options.combiner) {
     case Combiner::Ensemble: {
-      const MseEstimator estimator(guides, bases, options.mse);
+      const MseEstimator& estimator = ensembleEstimator.emplace(guides, bases, options.mse);
       SolvedWeights solved = solveWeights(estimator, options.solver, options.qp, options.seed);
       result.rawWeights = std::move(solved.weights);
       valid = std::move(solved.valid);
@@ -321,6 +323,19 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
     if (!filtersBeforeChoosing) clock.stop("filter");
   }
 
+  if (ensembleEstimator && options.mse.memberFallback > 0) {
+    // The blend where it is plausible, else one member: its weights become one-hot there.
+    const std::vector<int> member = ensembleEstimator->memberFallbacks(result.weights);
+    const int channels = result.weights[0].channels();
+    for (size_t p = 0; p < member.size(); ++p) {
+      if (member[p] < 0) continue;
+      ++result.memberFallbackPixels;
+      for (int i = 0; i < n; ++i)
+        for (int c = 0; c < channels; ++c)
+          result.weights[size_t(i)].data()[p * size_t(channels) + size_t(c)] =
+              i == member[p] ? 1.0f : 0.0f;
+    }
+  }
   Blends blends = blendAll(result.weights, bases, guides);
   if (!fallback.empty()) {
     result.noisyFallback = Image(w, h, 1);

@@ -63,7 +63,8 @@ struct CombineResult {
   Image noisyFallback;            // 1 where the ensemble's result is the noisy value
                                   // (MseOptions::noisyFallback), else 0 (1 channel)
   size_t noisyFallbackPixels = 0;
-  std::vector<StageTime> times;   // "solve", "filter", "blend"
+  size_t memberFallbackPixels = 0;  // where one member replaced the blend (memberFallback)
+  std::vector<StageTime> times;     // "solve", "filter", "blend"
 };
 
 // Throws chorus::Error for inconsistent inputs, or an oracle combiner without reference.

@@ -29,6 +29,10 @@ void checkEnsembleInputs(const EnsembleGuides& guides, std::span<const BaseOutpu
   checkImage(guides.colorB, "the noisy colour of half B", like);
   checkImage(guides.albedo, "the albedo", like);
   checkImage(guides.normal, "the normal", like);
+  if (!guides.quarters.empty() && guides.quarters.size() != 4)
+    throw Error("expected 4 noisy quarters, got " + std::to_string(guides.quarters.size()));
+  for (size_t k = 0; k < guides.quarters.size(); ++k)
+    checkImage(guides.quarters[k], "the noisy colour of quarter " + std::to_string(k), like);
   if (bases.empty()) throw Error("no base denoiser outputs to combine");
   if (bases.size() > size_t(kMaxDenoisers))
     throw Error("at most " + std::to_string(kMaxDenoisers) +
@@ -40,6 +44,15 @@ void checkEnsembleInputs(const EnsembleGuides& guides, std::span<const BaseOutpu
     checkImage(base->a, "the output of " + base->name + " on half A", like);
     checkImage(base->b, "the output of " + base->name + " on half B", like);
     checkImage(base->full, "the output of " + base->name + " on the full buffer", like);
+    if (base->heldOut.size() != bases[0]->heldOut.size() ||
+        (!base->heldOut.empty() && base->heldOut.size() != 4))
+      throw Error("base denoiser '" + base->name + "' has " + std::to_string(base->heldOut.size()) +
+                  " held-out runs (every base needs 0 or 4, and the same)");
+    if (!base->heldOut.empty() && guides.quarters.empty())
+      throw Error("held-out runs of '" + base->name + "' without the noisy quarters");
+    for (size_t k = 0; k < base->heldOut.size(); ++k)
+      checkImage(base->heldOut[k],
+                 "the output of " + base->name + " without quarter " + std::to_string(k), like);
   }
 }
 

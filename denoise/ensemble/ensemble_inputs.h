@@ -17,19 +17,26 @@ struct EnsembleGuides {
   Image color;           // full-buffer noisy colour (RGB): the fallback where no base is finite
   Image colorA, colorB;  // x^A, x^B: noisy half-buffer means (RGB)
   Image albedo, normal;  // full-buffer feature means (RGB / XYZ), guides of the weight filter
+  // x_0 … x_3, the noisy quarter means (RGB; K = 4 sub-buffers, half A = quarters 0 and 1):
+  // what the leave-one-quarter-out estimate compares the held-out runs with. Empty otherwise.
+  std::vector<Image> quarters;
 
   int width() const { return color.width(); }
   int height() const { return color.height(); }
 };
 
-// One base denoiser's outputs: y^A (run on half A only), y^B (half B only) and y (full buffer).
+// One base denoiser's outputs: y^A (run on half A only), y^B (half B only) and y (full buffer),
+// and, for the leave-one-quarter-out estimate, y^(−k): run on every quarter but k (k = 0 … 3;
+// denoise/pipeline/held_out_inputs.h). heldOut is empty when that estimate is not used.
 struct BaseOutputs {
   std::string name;
   Image a, b, full;
+  std::vector<Image> heldOut;
 };
 
 // Throws chorus::Error (one line naming the image) unless every guide and base output is RGB
-// of the guides' size, and there are 1 … kMaxDenoisers bases with distinct names.
+// of the guides' size, and there are 1 … kMaxDenoisers bases with distinct names. Quarters and
+// held-out runs are optional, but when given, four of each (the held-out runs of every base).
 void checkEnsembleInputs(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases);
 
 // Pointers to every element, for combine().

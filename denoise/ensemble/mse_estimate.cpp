@@ -21,16 +21,22 @@ constexpr int kPriorBandRows = 32;
 
 // The trace of a packed symmetric n × n matrix on the tangent space {Σv = 0}: tr H − 1ᵀH1/n,
 // the part of H the solve sees. entry(k) = the k-th packed entry.
+// Over the bases of `mask` only (the sub-matrix the solve sees where the others are missing).
 template <typename Entry>
-double tangentTrace(int n, const Entry& entry) {
+double tangentTrace(int n, BaseMask mask, const Entry& entry) {
   double trace = 0, total = 0;
-  for (int i = 0, k = 0; i < n; ++i)
+  int count = 0;
+  for (int i = 0, k = 0; i < n; ++i) {
+    const bool inI = (mask >> i) & 1u;
+    count += inI;
     for (int j = i; j < n; ++j, ++k) {
+      if (!inI || !((mask >> j) & 1u)) continue;
       const double v = entry(k);
       trace += i == j ? v : 0.0;
       total += i == j ? v : 2.0 * v;
     }
-  return trace - total / n;
+  }
+  return count > 0 ? trace - total / count : 0.0;
 }
 
 bool finite3(const float* v) {
@@ -111,16 +117,38 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
   if (!(options.noisyFallback == 0 || options.noisyFallback >= 1) ||
       !std::isfinite(options.noisyFallback))
     throw Error("the noisy fallback's factor must be 0 (off) or a finite number ≥ 1");
+  if (!(options.memberFallback == 0 || options.memberFallback >= 1) ||
+      !std::isfinite(options.memberFallback))
+    throw Error("the member fallback's factor must be 0 (off) or a finite number ≥ 1");
+  // Inputs without quarters (K = 2, an outputs directory) use the halves.
+  const bool quarters = options.estimate != MseEstimate::Halves && !reference &&
+                        guides.quarters.size() == 4 && bases[0]->heldOut.size() == 4;
   width_ = guides.width();
   height_ = guides.height();
   baseCount_ = int(bases.size());
+  for (int i = 0; i < baseCount_; ++i) outFull_[size_t(i)] = bases[size_t(i)]->full.data();
+  std::vector<Fold> halves(2), heldOut;
+  halves[0].comparator = guides.colorB.data();
+  halves[1].comparator = guides.colorA.data();
   for (int i = 0; i < baseCount_; ++i) {
-    outA_[size_t(i)] = bases[size_t(i)]->a.data();
-    outB_[size_t(i)] = bases[size_t(i)]->b.data();
-    outFull_[size_t(i)] = bases[size_t(i)]->full.data();
+    halves[0].out[size_t(i)] = bases[size_t(i)]->a.data();
+    halves[1].out[size_t(i)] = bases[size_t(i)]->b.data();
   }
-  colorA_ = guides.colorA.data();
-  colorB_ = guides.colorB.data();
+  if (quarters)
+    for (size_t k = 0; k < 4; ++k) {
+      Fold fold;
+      fold.comparator = guides.quarters[k].data();
+      for (int i = 0; i < baseCount_; ++i)
+        fold.out[size_t(i)] = bases[size_t(i)]->heldOut[k].data();
+      heldOut.push_back(fold);
+    }
+  folds_ = quarters ? heldOut : halves;
+  if (options.estimate == MseEstimate::Extrapolated && quarters) {
+    // e(s) = a + b/s at s = ½, ¾ and 1 of the samples: e(1) = 1.5 e(¾) − 0.5 e(½).
+    primaryWeight_ = 1.5;
+    secondaryFolds_ = halves;
+    secondaryWeight_ = -0.5;
+  }
   reference_ = reference ? reference->data() : nullptr;
 
   // Normalise the absolute form by the mean |x|², so that float planes hold O(1) values for
@@ -151,39 +179,51 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
 }
 
 std::vector<double> MseEstimator::imagePriorTerms() const {
-  // Bands in parallel, summed in band order (the same result for any thread count).
+  // Bands in parallel, summed in band order (the same result for any thread count). Each entry
+  // is the mean over the pixels where its bases are both present (a base missing over a region
+  // changes nothing in the other bases' entries).
   const int bands = (height_ + kPriorBandRows - 1) / kPriorBandRows;
+  const int n = baseCount_, entries = this->entries();
   std::vector<std::vector<double>> sums(static_cast<size_t>(bands));
-  std::vector<size_t> counts(static_cast<size_t>(bands), 0);
+  std::vector<std::vector<size_t>> counts(static_cast<size_t>(bands));
   tbb::parallel_for(0, bands, [&](int band) {
     const int y0 = band * kPriorBandRows, y1 = std::min(height_, y0 + kPriorBandRows);
     std::vector<float> planes;
     // Relative to μ̂² + (mean |x| / 2)²: every region counts by its relative error, as in
     // relMSE, but with a knee that follows the image's brightness, not its unit.
-    const std::vector<char> complete = pixelTerms(y0, y1, planes, 0.25 * scale_ * scale_);
-    const size_t pixels = complete.size();
+    const std::vector<BaseMask> present = pixelTerms(y0, y1, planes, 0.25 * scale_ * scale_);
+    const size_t pixels = present.size();
     std::vector<double>& sum = sums[size_t(band)];
+    std::vector<size_t>& count = counts[size_t(band)];
     sum.assign(size_t(planeCount()), 0.0);
+    count.assign(size_t(entries + 1), 0);
     for (size_t p = 0; p < pixels; ++p) {
-      if (!complete[p]) continue;
-      ++counts[size_t(band)];
-      for (int k = 0; k < planeCount(); ++k) sum[size_t(k)] += planes[size_t(k) * pixels + p];
+      const BaseMask mask = present[p];
+      if (mask == 0) continue;
+      for (int i = 0, k = 0; i < n; ++i)
+        for (int j = i; j < n; ++j, ++k) {
+          if (!((mask >> i) & 1u) || !((mask >> j) & 1u)) continue;
+          ++count[size_t(k)];
+          for (int g = 0; g < groups(); ++g)
+            sum[size_t(g * (entries + 1) + k)] +=
+                planes[size_t(g * (entries + 1) + k) * pixels + p];
+        }
     }
   });
   std::vector<double> mean(size_t(planeCount()), 0.0);
-  size_t count = 0;
+  std::vector<size_t> count(size_t(entries + 1), 0);
   for (int band = 0; band < bands; ++band) {
-    count += counts[size_t(band)];
+    for (int k = 0; k < entries; ++k) count[size_t(k)] += counts[size_t(band)][size_t(k)];
     for (int k = 0; k < planeCount(); ++k) mean[size_t(k)] += sums[size_t(band)][size_t(k)];
   }
-  if (count == 0) return {};
-  // Per group, divided by its tangent trace (a group without one adds nothing).
-  const int n = baseCount_, entries = this->entries();
-  for (int g = 0; g < groups(); ++g) {
-    double* group = mean.data() + size_t(g * (entries + 1));
-    const double trace = tangentTrace(n, [&](int k) { return group[k]; });
-    for (int k = 0; k < entries; ++k) group[k] = trace > 0 ? group[k] / trace : 0.0;
-  }
+  bool any = false;
+  for (int g = 0; g < groups(); ++g)
+    for (int k = 0; k < entries; ++k) {
+      double& v = mean[size_t(g * (entries + 1) + k)];
+      v = count[size_t(k)] > 0 ? v / double(count[size_t(k)]) : 0.0;
+      any = any || count[size_t(k)] > 0;
+    }
+  if (!any) return {};
   return mean;
 }
 
@@ -191,13 +231,19 @@ void MseEstimator::addImagePrior(MseRows& rows) const {
   if (imagePrior_.empty()) return;
   const int n = baseCount_, entries = this->entries();
   const size_t pixels = size_t(rows.y1_ - rows.y0_) * size_t(width_);
-  for (int g = 0; g < groups(); ++g) {
-    const double* prior = imagePrior_.data() + size_t(g * (entries + 1));
-    for (size_t p = 0; p < pixels; ++p) {
+  for (size_t p = 0; p < pixels; ++p) {
+    // Both traces over the bases present at the pixel: the prior and the local evidence are
+    // compared on the sub-matrix the solve sees there.
+    const BaseMask mask = validAt(size_t(rows.y0_) * size_t(width_) + p);
+    for (int g = 0; g < groups(); ++g) {
+      const double* prior = imagePrior_.data() + size_t(g * (entries + 1));
+      const double priorTrace = tangentTrace(n, mask, [&](int k) { return prior[k]; });
+      if (!(priorTrace > 0)) continue;
       float* h = rows.planes_.data() + size_t(g * (entries + 1)) * pixels + p;
-      const double local = tangentTrace(n, [&](int k) { return double(h[size_t(k) * pixels]); });
-      // No local evidence (no complete pixel in the window): the prior alone.
-      const double factor = local > 0 ? options_.imagePrior * local : 1.0;
+      const double local =
+          tangentTrace(n, mask, [&](int k) { return double(h[size_t(k) * pixels]); });
+      // No local evidence (no pixel with these bases in the window): the prior alone.
+      const double factor = (local > 0 ? options_.imagePrior * local : 1.0) / priorTrace;
       for (int k = 0; k < entries; ++k) h[size_t(k) * pixels] += float(factor * prior[k]);
     }
   }
@@ -211,9 +257,9 @@ BaseMask MseEstimator::validAt(size_t pixel) const {
   BaseMask mask = 0;
   const size_t e = pixel * 3;
   for (int i = 0; i < baseCount_; ++i) {
-    const bool finite =
-        finite3(outFull_[size_t(i)] + e) &&
-        (reference_ || (finite3(outA_[size_t(i)] + e) && finite3(outB_[size_t(i)] + e)));
+    bool finite = finite3(outFull_[size_t(i)] + e);
+    if (!reference_)
+      for (const Fold& fold : folds_) finite = finite && finite3(fold.out[size_t(i)] + e);
     if (finite) mask |= BaseMask(1) << i;
   }
   return mask;
@@ -234,17 +280,49 @@ MseEstimator::PixelMasks MseEstimator::masksAt(size_t pixel) const {
   BaseMask kept = options_.consistency > 0 ? consistentBases(pixel, valid) : valid;
   if (kept == 0) kept = valid;
   masks.solvable = kept;
-  const size_t e = pixel * 3;
   if (!(options_.plausibility > 0 || options_.noisyFallback > 0) || valid == 0 ||
-      !finite3(colorA_ + e) || !finite3(colorB_ + e))
+      !comparatorsFinite(pixel))
     return masks;
-  const HalfTerms terms = halfTermsAt(pixel, valid);
+  const FoldTerms terms = foldTermsAt(pixel, valid);
   if (options_.plausibility > 0) masks.solvable = plausibleBases(kept, terms);
   const double k2 = options_.noisyFallback * options_.noisyFallback;
-  masks.noisyFallback =
-      options_.noisyFallback > 0 &&
-      terms.least(valid, baseCount_).mean > k2 * (terms.halvesApart + terms.floorMean);
+  masks.noisyFallback = options_.noisyFallback > 0 &&
+                        terms.least(valid, baseCount_).mean > k2 * (terms.noise + terms.floorMean);
   return masks;
+}
+
+std::vector<int> MseEstimator::memberFallbacks(std::span<const Image> weights) const {
+  const size_t pixels = size_t(width_) * size_t(height_);
+  std::vector<int> out(pixels, -1);
+  if (!(options_.memberFallback > 0) || reference_) return out;
+  const double k2 = options_.memberFallback * options_.memberFallback;
+  const int channels = weights[0].channels();
+  tbb::parallel_for(size_t(0), pixels, [&](size_t p) {
+    const BaseMask valid = validAt(p);
+    if (valid == 0 || !comparatorsFinite(p)) return;
+    const FoldTerms terms = foldTermsAt(p, valid);
+    double blendTerm = 0;
+    for (const Fold& fold : folds_)
+      for (int c = 0; c < 3; ++c) {
+        const size_t ec = p * 3 + size_t(c);
+        double z = 0;
+        for (int i = 0; i < baseCount_; ++i) {
+          const double w =
+              weights[size_t(i)].data()[p * size_t(channels) + size_t(channels == 3 ? c : 0)];
+          if (w != 0) z += w * fold.out[size_t(i)][ec];
+        }
+        blendTerm += (z - fold.comparator[ec]) * (z - fold.comparator[ec]);
+      }
+    blendTerm /= double(folds_.size());
+    const double least = terms.least(valid, baseCount_).mean;
+    if (!(blendTerm > k2 * (least + terms.noise + terms.floorMean))) return;
+    for (int i = 0; i < baseCount_; ++i)
+      if (((valid >> i) & 1u) && terms.mean(i) == least) {
+        out[p] = i;
+        break;
+      }
+  });
+  return out;
 }
 
 BaseMask MseEstimator::consistentBases(size_t pixel, BaseMask mask) const {
@@ -254,10 +332,16 @@ BaseMask MseEstimator::consistentBases(size_t pixel, BaseMask mask) const {
     if (!((mask >> i) & 1u)) continue;
     bool close = true;
     for (int c = 0; c < 3; ++c) {
-      const double a = outA_[size_t(i)][e + size_t(c)], b = outB_[size_t(i)][e + size_t(c)];
-      const double full = outFull_[size_t(i)][e + size_t(c)], mean = 0.5 * (a + b);
+      // The mean of the fold runs and half their range (|y^A − y^B|/2 for the halves).
+      double low = std::numeric_limits<double>::infinity(), high = -low, mean = 0;
+      for (const Fold& fold : folds_) {
+        const double v = fold.out[size_t(i)][e + size_t(c)];
+        low = std::min(low, v), high = std::max(high, v), mean += v;
+      }
+      mean /= double(folds_.size());
+      const double full = outFull_[size_t(i)][e + size_t(c)];
       close =
-          close && std::abs(full - mean) <= options_.consistency * 0.5 * std::abs(a - b) +
+          close && std::abs(full - mean) <= options_.consistency * 0.5 * (high - low) +
                                                 kConsistencyAllowance * (scale_ + std::abs(mean));
     }
     if (close) consistent |= BaseMask(1) << i;
@@ -265,73 +349,112 @@ BaseMask MseEstimator::consistentBases(size_t pixel, BaseMask mask) const {
   return consistent;
 }
 
-MseEstimator::HalfTerms MseEstimator::halfTermsAt(size_t pixel, BaseMask mask) const {
+bool MseEstimator::comparatorsFinite(size_t pixel) const {
+  for (const Fold& fold : folds_)
+    if (!finite3(fold.comparator + pixel * 3)) return false;
+  return true;
+}
+
+double MseEstimator::comparatorNoise(size_t ec) const {
+  return comparatorNoise(folds_, ec);
+}
+
+double MseEstimator::comparatorNoise(const std::vector<Fold>& folds, size_t ec) {
+  // ((F − 1)/F)·(x_f − x̄_{−f})² is unbiased for Var(x_f) (equal variances): ½(x^A − x^B)² for
+  // the halves.
+  const double n = double(folds.size());
+  double sum = 0, noise = 0;
+  for (const Fold& fold : folds) sum += fold.comparator[ec];
+  for (const Fold& fold : folds) {
+    const double x = fold.comparator[ec], others = (sum - x) / (n - 1);
+    noise += (n - 1) / n * (x - others) * (x - others);
+  }
+  return noise / n;
+}
+
+MseEstimator::FoldTerms MseEstimator::foldTermsAt(size_t pixel, BaseMask mask) const {
   const size_t e = pixel * 3;
-  HalfTerms t;
+  FoldTerms t;
+  t.folds = int(folds_.size());
   for (int c = 0; c < 3; ++c) {
-    const double xA = colorA_[e + size_t(c)], xB = colorB_[e + size_t(c)];
-    const double fA = kConsistencyAllowance * (scale_ + std::abs(xA));
-    const double fB = kConsistencyAllowance * (scale_ + std::abs(xB));
-    const double fMean = kConsistencyAllowance * (scale_ + 0.5 * std::abs(xA + xB));
-    t.floorA += fA * fA, t.floorB += fB * fB, t.floorMean += fMean * fMean;
-    t.halvesApart += 0.5 * (xA - xB) * (xA - xB);
+    const size_t ec = e + size_t(c);
+    double mean = 0;
+    for (size_t f = 0; f < folds_.size(); ++f) {
+      const double x = folds_[f].comparator[ec];
+      const double floor = kConsistencyAllowance * (scale_ + std::abs(x));
+      t.floor[f] += floor * floor;
+      mean += x / double(folds_.size());
+    }
+    const double fMean = kConsistencyAllowance * (scale_ + std::abs(mean));
+    t.floorMean += fMean * fMean;
+    t.noise += comparatorNoise(ec);
   }
   for (int i = 0; i < baseCount_; ++i) {
     if (!((mask >> i) & 1u)) continue;
-    for (int c = 0; c < 3; ++c) {
-      const size_t ec = e + size_t(c);
-      const double toB = double(outA_[size_t(i)][ec]) - colorB_[ec];
-      const double toA = double(outB_[size_t(i)][ec]) - colorA_[ec];
-      t.a[size_t(i)] += toB * toB, t.b[size_t(i)] += toA * toA;
-    }
+    for (size_t f = 0; f < folds_.size(); ++f)
+      for (int c = 0; c < 3; ++c) {
+        const size_t ec = e + size_t(c);
+        const double d = double(folds_[f].out[size_t(i)][ec]) - folds_[f].comparator[ec];
+        t.t[f][size_t(i)] += d * d;
+      }
   }
   return t;
 }
 
-MseEstimator::HalfTerms::Least MseEstimator::HalfTerms::least(BaseMask mask, int baseCount) const {
+double MseEstimator::FoldTerms::mean(int i) const {
+  double sum = 0;
+  for (int f = 0; f < folds; ++f) sum += t[size_t(f)][size_t(i)];
+  return sum / folds;
+}
+
+MseEstimator::FoldTerms::Least MseEstimator::FoldTerms::least(BaseMask mask, int baseCount) const {
   const double inf = std::numeric_limits<double>::infinity();
-  Least l{inf, inf, inf};
+  Least l;
+  l.fold.fill(inf);
+  l.mean = inf;
   for (int i = 0; i < baseCount; ++i)
-    if ((mask >> i) & 1u)
-      l.a = std::min(l.a, a[size_t(i)]), l.b = std::min(l.b, b[size_t(i)]),
+    if ((mask >> i) & 1u) {
+      for (int f = 0; f < folds; ++f)
+        l.fold[size_t(f)] = std::min(l.fold[size_t(f)], t[size_t(f)][size_t(i)]);
       l.mean = std::min(l.mean, mean(i));
+    }
   return l;
 }
 
-BaseMask MseEstimator::plausibleBases(BaseMask mask, const HalfTerms& t) const {
-  const HalfTerms::Least least = t.least(mask, baseCount_);
+BaseMask MseEstimator::plausibleBases(BaseMask mask, const FoldTerms& t) const {
+  const FoldTerms::Least least = t.least(mask, baseCount_);
   // The whole-pixel test; the least d always passes (κ ≥ 1), so it never empties the mask.
   const double k2 = options_.plausibility * options_.plausibility;
-  const double limit = k2 * (least.mean + t.halvesApart + t.floorMean);
-  // Each half's test, at 2κ: the term of a half whose comparator is a firefly is useless, and
-  // its size in the mean d hides the other half's evidence.
-  const double limitA = 4.0 * k2 * (least.a + t.floorB);
-  const double limitB = 4.0 * k2 * (least.b + t.floorA);
-  BaseMask plausible = 0, inBothHalves = 0;
+  const double limit = k2 * (least.mean + t.noise + t.floorMean);
+  BaseMask plausible = 0, inEveryFold = 0;
   for (int i = 0; i < baseCount_; ++i) {
     if (!((mask >> i) & 1u) || t.mean(i) > limit) continue;
     plausible |= BaseMask(1) << i;
-    if (t.a[size_t(i)] <= limitA && t.b[size_t(i)] <= limitB) inBothHalves |= BaseMask(1) << i;
+    // Each fold's test, at 2κ: the term of a fold whose comparator is a firefly is useless, and
+    // its size in the mean d hides the other folds' evidence.
+    bool everyFold = true;
+    for (int f = 0; f < t.folds; ++f)
+      everyFold = everyFold && t.t[size_t(f)][size_t(i)] <=
+                                   4.0 * k2 * (least.fold[size_t(f)] + t.floor[size_t(f)]);
+    if (everyFold) inEveryFold |= BaseMask(1) << i;
   }
-  // The half tests may together reject every base (each half's best fails the other's test).
-  return inBothHalves != 0 ? inBothHalves : plausible;
+  // The fold tests may together reject every base (each fold's best fails another's test).
+  return inEveryFold != 0 ? inEveryFold : plausible;
 }
 
-std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes,
-                                           double relativeEpsilon) const {
+std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes,
+                                               double relativeEpsilon) const {
   const bool relative = relativeEpsilon >= 0;
   const int n = baseCount_, entries = this->entries();
   const size_t pixels = size_t(y1 - y0) * size_t(width_);
   planes.assign(size_t(planeCount()) * pixels, 0.0f);
-  std::vector<char> complete(pixels, 0);
-  const BaseMask all = allBases(n);
+  std::vector<BaseMask> present(pixels, 0);
   std::array<double, 3 * ((kMaxDenoisers * (kMaxDenoisers + 1)) / 2 + 1)> acc{};
-  std::array<double, kMaxDenoisers> first{}, second{};
+  std::array<double, kMaxDenoisers> first{};
   for (size_t local = 0; local < pixels; ++local) {
     const size_t q = size_t(y0) * size_t(width_) + local;
     const size_t e = q * 3;
-    if (reference_ ? !finite3(reference_ + e) : !(finite3(colorA_ + e) && finite3(colorB_ + e)))
-      continue;
+    if (reference_ ? !finite3(reference_ + e) : !comparatorsFinite(q)) continue;
     const BaseMask valid = validAt(q);
     std::fill(acc.begin(), acc.begin() + planeCount(), 0.0);
     for (int c = 0; c < 3; ++c) {
@@ -360,19 +483,23 @@ std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& p
           for (int j = i; j < n; ++j, ++k) h[k] += weight * first[size_t(i)] * first[size_t(j)];
         continue;
       }
-      // e^A = y^A − x^B, e^B = y^B − x^A; H += ½(e^A e^Aᵀ + e^B e^Bᵀ), c += −½(x^A − x^B)².
-      const double xA = colorA_[ec], xB = colorB_[ec];
-      for (int i = 0; i < n; ++i) {
-        const bool on = (valid >> i) & 1u;
-        first[size_t(i)] = on ? double(outA_[size_t(i)][ec]) - xB : 0.0;
-        second[size_t(i)] = on ? double(outB_[size_t(i)][ec]) - xA : 0.0;
+      // Per fold f, e_f = y^f − x_f (halves: e^A = y^A − x^B, e^B = y^B − x^A);
+      // H += (1/F) Σ_f e_f e_fᵀ, c −= the comparators' estimated variance (½(x^A − x^B)²).
+      // Extrapolated: 1.5 times the quarters' terms minus 0.5 times the halves'.
+      const std::pair<const std::vector<Fold>*, double> groups[] = {
+          {&folds_, primaryWeight_}, {&secondaryFolds_, secondaryWeight_}};
+      for (const auto& [folds, groupWeight] : groups) {
+        if (folds->empty()) continue;
+        const double share = groupWeight * weight / double(folds->size());
+        for (const Fold& fold : *folds) {
+          const double x = fold.comparator[ec];
+          for (int i = 0; i < n; ++i)
+            first[size_t(i)] = ((valid >> i) & 1u) ? double(fold.out[size_t(i)][ec]) - x : 0.0;
+          for (int i = 0, k = 0; i < n; ++i)
+            for (int j = i; j < n; ++j, ++k) h[k] += share * first[size_t(i)] * first[size_t(j)];
+        }
+        h[entries] -= groupWeight * weight * comparatorNoise(*folds, ec);
       }
-      const double half = 0.5 * weight;
-      for (int i = 0, k = 0; i < n; ++i)
-        for (int j = i; j < n; ++j, ++k)
-          h[k] +=
-              half * (first[size_t(i)] * first[size_t(j)] + second[size_t(i)] * second[size_t(j)]);
-      h[entries] -= half * (xA - xB) * (xA - xB);
     }
     if (options_.outlierCap > 0 && !reference_) {
       double trace = 0;
@@ -386,9 +513,9 @@ std::vector<char> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& p
     if (!finite) continue;
     for (int k = 0; k < planeCount(); ++k)
       planes[size_t(k) * pixels + local] = float(acc[size_t(k)]);
-    complete[local] = valid == all;
+    present[local] = valid;
   }
-  return complete;
+  return present;
 }
 
 MseRows MseEstimator::rows(int y0, int y1) const {
@@ -417,23 +544,55 @@ MseRows MseEstimator::rows(int y0, int y1) const {
     addImagePrior(out);
     return out;
   }
-  // Per-pixel terms of the rows the window reaches; pixels with a non-finite input are left
-  // out of every window; then the joint-bilateral window.
+  // Per-pixel terms of the rows the window reaches, then the joint-bilateral window. A pixel
+  // where some bases are missing (non-finite) still adds the entries of the bases present;
+  // where any is missing, presence planes (1 where base i is present, 1 where the pixel has
+  // terms at all) are filtered alongside, and entry (i, j) is divided by the window's share of
+  // pixels with both present: the window's mean over the pixels that have the entry (exact
+  // where one base has holes, an approximation where several have different ones).
   const int inY0 = std::max(0, y0 - r), inY1 = std::min(height_, y1 + r);
   std::vector<float> in;
-  const std::vector<char> complete = pixelTerms(inY0, inY1, in, objectiveEpsilon());
+  const std::vector<BaseMask> present = pixelTerms(inY0, inY1, in, objectiveEpsilon());
   const size_t inPixels = size_t(inY1 - inY0) * size_t(width_);
-  for (size_t local = 0; local < inPixels; ++local)
-    if (!complete[local])
-      for (int k = 0; k < planeCount(); ++k) in[size_t(k) * inPixels + local] = 0.0f;
+  const BaseMask all = allBases(baseCount_);
+  const bool holes =
+      std::any_of(present.begin(), present.end(), [&](BaseMask m) { return m != 0 && m != all; });
+  const int presencePlanes = holes ? baseCount_ + 1 : 0;
+  if (holes) {
+    in.resize(size_t(planeCount() + presencePlanes) * inPixels, 0.0f);
+    float* presence = in.data() + size_t(planeCount()) * inPixels;
+    for (size_t local = 0; local < inPixels; ++local) {
+      if (present[local] == 0) continue;
+      presence[local] = 1.0f;
+      for (int i = 0; i < baseCount_; ++i)
+        if ((present[local] >> i) & 1u) presence[size_t(i + 1) * inPixels + local] = 1.0f;
+    }
+  }
   out.planes_.assign(size_t(planeCount()) * pixels, 0.0f);
+  std::vector<float> outPresence(size_t(presencePlanes) * pixels);
   std::vector<const float*> inPlanes;
   std::vector<float*> outPlanes;
-  for (int k = 0; k < planeCount(); ++k) {
+  for (int k = 0; k < planeCount() + presencePlanes; ++k) {
     inPlanes.push_back(in.data() + size_t(k) * inPixels);
-    outPlanes.push_back(out.planes_.data() + size_t(k) * pixels);
+    outPlanes.push_back(k < planeCount() ? out.planes_.data() + size_t(k) * pixels
+                                         : outPresence.data() + size_t(k - planeCount()) * pixels);
   }
   filterPlaneRows(windowGuides_, windowKernel_, inPlanes, inY0, y0, y1, outPlanes);
+  if (holes) {
+    const int n = baseCount_, entries = this->entries();
+    for (size_t p = 0; p < pixels; ++p) {
+      const float any = outPresence[p];
+      for (int i = 0, k = 0; i < n; ++i)
+        for (int j = i; j < n; ++j, ++k) {
+          const float share = std::min(outPresence[size_t(i + 1) * pixels + p],
+                                       outPresence[size_t(j + 1) * pixels + p]);
+          for (int g = 0; g < groups(); ++g) {
+            float& v = out.planes_[size_t(g * (entries + 1) + k) * pixels + p];
+            v = share > 0 ? v * (any / share) : 0.0f;
+          }
+        }
+    }
+  }
   addImagePrior(out);
   return out;
 }

@@ -59,16 +59,22 @@
 //   blend that is best over the whole image: a window holds ~100 pixels whose noisy halves, at
 //   a few samples per pixel, cannot rank bases that differ by less than their noise, while the
 //   image-wide mean can; where one base is clearly better locally its H still decides. A pixel
-//   whose window holds no complete pixel gets Ḡ alone. Not applied to the oracle.
+//   whose window holds no pixel with its bases gets Ḡ alone. Not applied to the oracle.
 // - noisyFallback K (0 = off, else ≥ 1; applied by the ensemble combiner): where even the best
 //   base's d_i exceeds K²·(½ Σ_c (x^A − x^B)² + Σ_c (0.1·(mean |x| + |x̄|))²), the result is the
 //   noisy full-buffer value. Every base then spread energy into the pixel that neither half
 //   shows (a lamp's bulb smeared onto the black pixel beside it: LightsPunctualLamp, 128 spp,
 //   rdfc 22 and sbf 3.5 where the reference is 0.03 and all four sub-buffers 0.0001), and no
-//   blend of them can be right; the pixel's own samples can.
-// Non-finite inputs: a base whose output (A, B or full) is NaN/Inf at a pixel is invalid there
-// (its bit in `valid` is 0; the solver gives it weight 0). A pixel where any base or x^A/x^B is
-// non-finite contributes nothing to its neighbours' windows.
+//   blend of them can be right; the pixel's own samples can. Off by default (issue 25): where
+//   the noisy value is the implausible one (a few samples per pixel of a light reached through
+//   one bounce: both halves 0, every member lit from the neighbours) it made black speckle, and
+//   it lost on the evaluation corpus (docs/ensemble-quality.md).
+// Non-finite inputs: a base whose output (any run) is NaN/Inf at a pixel is invalid there (its
+// bit in `valid` is 0; the solver gives it weight 0). The pixel still adds the entries of the
+// other bases to its neighbours' windows, and each windowed entry is the mean over the pixels
+// where both its bases are present (issue 26: one bad member changes nothing where the others
+// are fine); the image prior's entries likewise, and its scale is taken over the bases present
+// at each pixel. A pixel whose noisy comparators are non-finite adds nothing.
 #include <array>
 #include <limits>
 #include <span>
@@ -82,15 +88,37 @@ namespace chorus {
 
 enum class MseForm { PerChannel, Summed };
 
+// Which runs the estimate compares with which noisy means ("folds"):
+// - Halves: y^A with x^B and y^B with x^A (the paper's dual-buffer estimate): the error of a
+//   run on half the samples.
+// - Quarters: y^(−k), the run on every quarter but k, with x_k (k = 0 … 3; needs K = 4 and the
+//   held-out runs): the error of a run on 3/4 of the samples, closer to the full run's at a
+//   few samples per pixel, where members that split their own input (NFOR, RDFC) are much
+//   better on the full buffer than on a half. Unbiased for the same reason: y^(−k) does not
+//   see quarter k.
+// - Extrapolated: 1.5 × the quarters' estimate − 0.5 × the halves' (an error that falls as
+//   a + b/s with the share s of the samples, extrapolated from s = ½ and ¾ to 1). Not unbiased
+//   for any run's error; may be indefinite (the solver then finds a feasible local minimiser).
+// Quarters and Extrapolated fall back to Halves where the inputs have no quarters and held-out
+// runs (K = 2 renders, a directory of outputs).
+enum class MseEstimate { Halves, Quarters, Extrapolated };
+inline const char* estimateName(MseEstimate e) {
+  return e == MseEstimate::Halves     ? "halves"
+         : e == MseEstimate::Quarters ? "quarters"
+                                      : "extrapolated";
+}
+
 struct MseOptions {
   MseForm form = MseForm::Summed;
+  MseEstimate estimate = MseEstimate::Quarters;
   int windowRadius = 5;
   bool relative = false;
   double outlierCap = 30.0;
   double consistency = 4.0;
   double plausibility = 4.0;
   double imagePrior = 0.3;
-  double noisyFallback = 10.0;
+  double noisyFallback = 0.0;
+  double memberFallback = 0.0;
   float windowSigmaSpatial = 0;  // σ_s in pixels; 0 = the window radius
   float windowSigmaNormal = 0.2f;
   float windowSigmaAlbedo = 0.1f;
@@ -159,35 +187,56 @@ class MseEstimator {
   // K²·(½ Σ_c (x^A − x^B)² + Σ_c (0.1·(mean |x| + |x̄|))²): every base is far from both noisy
   // halves, which agree (see noisyFallback).
   bool noBasePlausible(size_t pixel) const;
+  // memberFallback K (0 = off, else ≥ 1): per pixel, the base to use instead of the blend of
+  // `weights` (one map per base, 1 or 3 channels), or −1 to keep the blend. Where the blend's
+  // own error term d_z = mean over the folds of Σ_c (z^f − x_f)², z^f = Σ_i w_i y_i^f, exceeds
+  // K²·(min_i d_i + the comparators' noise + the 10 % floor), the base with the least d_i is
+  // used: a safeguard that chooses between the blend and a member, never the noisy value.
+  std::vector<int> memberFallbacks(std::span<const Image> weights) const;
 
  private:
   MseEstimator(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,
                const MseOptions& options, const Image* reference);
-  // Per-pixel (unwindowed) planes for rows [y0, y1); returns per pixel whether every base and
-  // the noisy halves were finite (only such pixels may enter a neighbour's window).
+  // Per-pixel (unwindowed) planes for rows [y0, y1); returns per pixel the bases whose entries
+  // it holds (finite there; 0: the pixel holds nothing, e.g. a non-finite noisy comparator).
   // relativeEpsilon < 0: absolute units (divided by scale²); else divided by μ̂² + relativeEpsilon.
-  std::vector<char> pixelTerms(int y0, int y1, std::vector<float>& planes,
-                               double relativeEpsilon) const;
+  std::vector<BaseMask> pixelTerms(int y0, int y1, std::vector<float>& planes,
+                                   double relativeEpsilon) const;
   double objectiveEpsilon() const;
-  // The mean of the relative per-pixel terms over the complete pixels, per group divided by its
-  // tangent trace (empty when no pixel is complete).
+  // The mean of the relative per-pixel terms, each entry over the pixels where both its bases
+  // are present (empty when no pixel has any); addImagePrior scales it per pixel.
   std::vector<double> imagePriorTerms() const;
   // H += imagePrior · (tangent trace of H) · imagePrior_, per pixel of `rows`.
   void addImagePrior(MseRows& rows) const;
-  // Per base of a mask at a pixel: each half's own error term, tA_i = Σ_c (y_i^A − x^B)² and
-  // tB_i = Σ_c (y_i^B − x^A)², and the allowances the tests compare them with.
-  struct HalfTerms {
-    std::array<double, kMaxDenoisers> a{}, b{};
-    double floorA = 0, floorB = 0, floorMean = 0;  // Σ_c (0.1 (mean |x| + |x|))² of x^A, x^B, x̄
-    double halvesApart = 0;                        // ½ Σ_c (x^A − x^B)²
-    double mean(int i) const { return 0.5 * (a[size_t(i)] + b[size_t(i)]); }  // d_i
-    struct Least {
-      double a, b, mean;
-    };
-    Least least(BaseMask mask, int baseCount) const;  // least tA, tB and d over `mask`
+  // One fold of the estimate: every base's run that did not see `comparator`, the noisy mean
+  // it is compared with (halves: y^A with x^B, y^B with x^A; quarters: y^(−k) with x_k).
+  struct Fold {
+    std::array<const float*, kMaxDenoisers> out{};
+    const float* comparator = nullptr;
   };
-  HalfTerms halfTermsAt(size_t pixel, BaseMask mask) const;
-  // The solver's mask and the fallback flag at a pixel, from one evaluation of the half terms.
+  static constexpr int kMaxFolds = 4;
+  bool comparatorsFinite(size_t pixel) const;
+  // The estimated variance of a comparator at one value index (pixel·3 + channel), averaged
+  // over the folds: ½(x^A − x^B)² for the halves.
+  double comparatorNoise(size_t valueIndex) const;
+  static double comparatorNoise(const std::vector<Fold>& folds, size_t valueIndex);
+  // Per base of a mask at a pixel: each fold's own error term t_f,i = Σ_c (y_i^f − x_f)², and
+  // the allowances the tests compare them with.
+  struct FoldTerms {
+    int folds = 0;
+    std::array<std::array<double, kMaxDenoisers>, kMaxFolds> t{};
+    std::array<double, kMaxFolds> floor{};  // Σ_c (0.1 (mean |x| + |x_f|))² per comparator
+    double floorMean = 0;                   // the same of the comparators' mean
+    double noise = 0;                       // Σ_c comparatorNoise (½ Σ_c (x^A − x^B)²)
+    double mean(int i) const;               // d_i: the mean over the folds
+    struct Least {
+      std::array<double, kMaxFolds> fold;
+      double mean;
+    };
+    Least least(BaseMask mask, int baseCount) const;  // least t_f and d over `mask`
+  };
+  FoldTerms foldTermsAt(size_t pixel, BaseMask mask) const;
+  // The solver's mask and the fallback flag at a pixel, from one evaluation of the fold terms.
   struct PixelMasks {
     BaseMask solvable = 0;
     bool noisyFallback = false;
@@ -195,16 +244,17 @@ class MseEstimator {
   PixelMasks masksAt(size_t pixel) const;
   // The bases of `mask` that pass the consistency test / the plausibility test at a pixel.
   BaseMask consistentBases(size_t pixel, BaseMask mask) const;
-  BaseMask plausibleBases(BaseMask mask, const HalfTerms& terms) const;
+  BaseMask plausibleBases(BaseMask mask, const FoldTerms& terms) const;
   int planeCount() const { return groups() * (entries() + 1); }
   int entries() const { return baseCount_ * (baseCount_ + 1) / 2; }
 
   MseOptions options_;
   int width_ = 0, height_ = 0, baseCount_ = 0;
   double scale_ = 1.0;  // absolute form: values are divided by scale² (scale = mean |x|)
-  std::array<const float*, kMaxDenoisers> outA_{}, outB_{}, outFull_{};
-  const float* colorA_ = nullptr;
-  const float* colorB_ = nullptr;
+  std::array<const float*, kMaxDenoisers> outFull_{};
+  std::vector<Fold> folds_;           // the tests' folds and the estimate's (weight primary)
+  std::vector<Fold> secondaryFolds_;  // Extrapolated: the halves (weight secondary)
+  double primaryWeight_ = 1.0, secondaryWeight_ = 0.0;
   const float* reference_ = nullptr;  // oracle only
   std::vector<double> imagePrior_;    // imagePriorTerms() (empty: no prior)
   PlanarGuides windowGuides_;

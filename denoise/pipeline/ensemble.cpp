@@ -8,6 +8,7 @@
 #include "common/stopwatch.h"
 #include "denoise/base/registry.h"
 #include "denoise/ensemble/ensemble_types.h"
+#include "denoise/pipeline/held_out_inputs.h"
 
 namespace chorus {
 
@@ -99,32 +100,49 @@ bool readsHalves(std::span<const EnsembleMember> members) {
   return false;
 }
 
+bool usesHeldOutRuns(const MseOptions& options, const EnsembleSources& sources) {
+  return options.estimate != MseEstimate::Halves && hasQuarters(sources);
+}
+
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
-                                          std::vector<StageTime>* times) {
+                                          std::vector<StageTime>* times, bool heldOut) {
   checkMembersCanRun(sources, members);
   const Stopwatch all;
+  const std::vector<DenoiseInput> heldOutInputList =
+      heldOut ? heldOutInputs(sources) : std::vector<DenoiseInput>{};
+  std::vector<const DenoiseInput*> inputs = {&sources.a, &sources.b, &sources.full};
+  for (const DenoiseInput& input : heldOutInputList) inputs.push_back(&input);
+  const size_t parts = inputs.size();
   std::vector<BaseOutputs> outputs(members.size());
-  std::vector<double> seconds(members.size() * 3);
-  const DenoiseInput* inputs[3] = {&sources.a, &sources.b, &sources.full};
+  std::vector<double> seconds(members.size() * parts);
   tbb::task_group group;
   for (size_t m = 0; m < members.size(); ++m) {
-    outputs[m].name = members[m].label;
-    Image* targets[3] = {&outputs[m].a, &outputs[m].b, &outputs[m].full};
-    for (int part = 0; part < 3; ++part) {
-      group.run([&, m, part, target = targets[part]] {
+    BaseOutputs& o = outputs[m];
+    o.name = members[m].label;
+    o.heldOut.resize(heldOutInputList.size());
+    for (size_t part = 0; part < parts; ++part) {
+      Image* target = part == 0   ? &o.a
+                      : part == 1 ? &o.b
+                      : part == 2 ? &o.full
+                                  : &o.heldOut[part - 3];
+      group.run([&, m, part, target] {
         const Stopwatch run;
         *target = members[m].denoiser->run(*inputs[part]);
-        seconds[m * 3 + size_t(part)] = run.seconds();
+        seconds[m * parts + part] = run.seconds();
       });
     }
   }
   group.wait();
   if (times) {
-    const char* partNames[3] = {"A", "B", "full"};
     for (size_t m = 0; m < members.size(); ++m)
-      for (int part = 0; part < 3; ++part)
-        times->push_back({members[m].label + "/" + partNames[part], seconds[m * 3 + size_t(part)]});
+      for (size_t part = 0; part < parts; ++part) {
+        const std::string partName = part == 0   ? "A"
+                                     : part == 1 ? "B"
+                                     : part == 2 ? "full"
+                                                 : "without-q" + std::to_string(part - 3);
+        times->push_back({members[m].label + "/" + partName, seconds[m * parts + part]});
+      }
     times->push_back({"bases", all.seconds()});
   }
   return outputs;
@@ -144,8 +162,9 @@ EnsembleResult Ensemble::run(const SampleBuffers& buffers, const Image* referenc
 
 EnsembleResult Ensemble::run(const EnsembleSources& sources, const Image* reference) const {
   EnsembleResult result;
-  result.bases = runBaseDenoisers(sources, members_, &result.times);
-  result.guides = guidesFromSources(sources);
+  const bool heldOut = usesHeldOutRuns(options_.mse, sources);
+  result.bases = runBaseDenoisers(sources, members_, &result.times, heldOut);
+  result.guides = guidesFromSources(sources, heldOut);
   result.combined = combine(result.guides, pointersTo(result.bases), options_, reference);
   result.times.insert(result.times.end(), result.combined.times.begin(),
                       result.combined.times.end());

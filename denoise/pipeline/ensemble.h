@@ -1,6 +1,7 @@
 #pragma once
-// The ensemble runner: runs the chosen base denoisers on half A, half B and the full buffer (all
-// 3N runs in parallel as TBB tasks), then combines their outputs (combiners.h) and reports the
+// The ensemble runner: runs the chosen base denoisers on half A, half B and the full buffer, and
+// for the leave-one-quarter-out estimate on the four held-out inputs (all 3N or 7N runs in
+// parallel as TBB tasks), then combines their outputs (combiners.h) and reports the
 // time of every stage. For sweeps that reuse base outputs across combinations, call
 // runBaseDenoisers() once and combine() per combination instead. runMembersAlone() runs members
 // on one input only, without the ensemble (`chorus denoise --combine none`).
@@ -51,11 +52,19 @@ std::vector<Image> runMembersAlone(const DenoiseInput& input,
                                    std::span<const EnsembleMember> members,
                                    std::vector<StageTime>* times = nullptr);
 
-// Every member on sources.a, .b and .full, in parallel. Appends "<label>/A", "<label>/B",
-// "<label>/full" (the time of each run) and "bases" (wall time of all of them) to `times`.
+// Whether the ensemble's estimate uses held-out runs: the options ask for the quarters (or the
+// extrapolated) estimate and the sources carry four independent quarters (K = 4). Otherwise it
+// uses the halves.
+bool usesHeldOutRuns(const MseOptions& options, const EnsembleSources& sources);
+
+// Every member on sources.a, .b and .full, and with `heldOut` also on the four inputs without
+// one quarter (held_out_inputs.h), in parallel. Appends "<label>/A", "<label>/B",
+// "<label>/full", "<label>/without-q<k>" (the time of each run) and "bases" (wall time of all
+// of them) to `times`.
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
-                                          std::vector<StageTime>* times = nullptr);
+                                          std::vector<StageTime>* times = nullptr,
+                                          bool heldOut = false);
 
 struct EnsembleResult {
   CombineResult combined;          // image, weights, A/B blends, estimated MSE

@@ -50,13 +50,24 @@ EnsembleSources sourcesFromHalves(const DenoiseInput& input) {
   return sources;
 }
 
-EnsembleGuides guidesFromSources(const EnsembleSources& sources) {
+EnsembleGuides guidesFromSources(const EnsembleSources& sources, bool withQuarters) {
   EnsembleGuides guides;
   guides.color = sources.full.whole.color.mean;
   // The halves the error estimate compares the members with, as the members saw them: with the
   // outlier guard's clamps. A firefly left in x^B would dominate every (y^A − x^B)² around it.
   guides.colorA = guardOutliers(sources.a).input.whole.color.mean;
   guides.colorB = guardOutliers(sources.b).input.whole.color.mean;
+  // With K = 4 the halves' own halves are the quarters the leave-one-quarter-out estimate
+  // compares the held-out runs with (quarter k = half k / 2, own half k % 2). Each is guarded
+  // on its own samples: confirmed by the other quarter of its half, it would depend on samples
+  // that the run it is compared with has seen.
+  if (withQuarters && sources.a.halves && sources.b.halves)
+    for (const DenoiseInput* half : {&sources.a, &sources.b})
+      for (const SubBuffer& quarter : *half->halves) {
+        DenoiseInput alone;
+        alone.whole = quarter;
+        guides.quarters.push_back(guardOutliers(std::move(alone)).input.whole.color.mean);
+      }
   guides.albedo = sources.full.whole.albedo.mean;
   guides.normal = sources.full.whole.normal.mean;
   return guides;

@@ -30,7 +30,8 @@ EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull);
 EnsembleSources sourcesFromHalves(const DenoiseInput& input);
 
 // The noisy colour of the full buffer, both halves (through the outlier guard, as the members
-// see them: denoise/base/outlier_guard.h), and the full buffer's albedo and normal.
-EnsembleGuides guidesFromSources(const EnsembleSources& sources);
+// see them: denoise/base/outlier_guard.h), and the full buffer's albedo and normal; with
+// `withQuarters` and K = 4 also the four quarters (each guarded on its own samples).
+EnsembleGuides guidesFromSources(const EnsembleSources& sources, bool withQuarters = false);
 
 }  // namespace chorus

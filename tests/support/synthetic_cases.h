@@ -22,6 +22,8 @@
 //           σ_s = 3 — keeps strong lighting edges, leaves noise on weak ones
 //   biased  Gaussian σ = 1.5 of min(colour, 1.5) — clamps highlights (an LDR-trained
 //           denoiser's typical bias)
+//   median5 per channel the median of the 5×5 window — nonlinear: its error has no linear
+//           relation to its input's
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -53,7 +55,7 @@ Image expectedValue(const Scene& scene, const NoiseModel& model);
 // `splits` independent sub-buffers of the scene (features noise-free).
 SampleBuffers renderBuffers(const Scene& scene, const NoiseModel& model, int splits, uint64_t seed);
 
-// "box1", "gauss3", "guided", "nlm", "biased"; throws chorus::Error otherwise.
+// "box1", "gauss3", "guided", "nlm", "biased", "median5"; throws chorus::Error otherwise.
 std::unique_ptr<BaseDenoiser> createSyntheticDenoiser(const std::string& name);
 // A denoiser that returns a fixed image whatever its input (e.g. the truth: a perfect member).
 std::unique_ptr<BaseDenoiser> createConstantDenoiser(const std::string& name, const Image& image);

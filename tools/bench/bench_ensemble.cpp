@@ -1,5 +1,7 @@
 // Times the ensemble's combination step (solve + weight filter + blend) on 1 megapixel with
-// N = 4 base outputs, for the default path (MSE window) and per pixel (the paper's form), and
+// N = 4 base outputs (with their held-out runs: the default estimate compares them with the
+// quarters), for the default path (MSE window), the halves estimate and per pixel (the paper's
+// form), and
 // prints seconds per megapixel (wall clock, and process CPU time: on a busy machine the CPU
 // time divided by the thread count is the better estimate of the quiet-machine wall time). Base
 // outputs are separable box blurs of a synthetic render (their cost is not measured here). The
@@ -25,6 +27,7 @@
 #include "common/stopwatch.h"
 #include "denoise/ensemble/combiners.h"
 #include "denoise/metrics/metrics.h"
+#include "denoise/pipeline/held_out_inputs.h"
 #include "tests/support/synthetic_cases.h"
 
 namespace {
@@ -127,15 +130,20 @@ int main(int argc, char** argv) {
   const synthetic::NoiseModel noise{1.0f, 4, 0.0f};
   const SampleBuffers buffers = synthetic::renderBuffers(scene, noise, 4, 7);
   const EnsembleSources sources = sourcesFromBuffers(buffers);
-  const EnsembleGuides guides = guidesFromSources(sources);
+  const EnsembleGuides guides = guidesFromSources(sources, true);
+  const std::vector<DenoiseInput> heldOut = heldOutInputs(sources);
   std::vector<BaseOutputs> bases;
   const int radii[4] = {1, 2, 4, 2};
   const float clamps[4] = {0, 0, 0, 0.5f};
-  for (int i = 0; i < 4; ++i)
+  for (int i = 0; i < 4; ++i) {
     bases.push_back({"box" + std::to_string(radii[i]) + (clamps[i] > 0 ? "clamped" : ""),
                      boxBlur(guides.colorA, radii[i], clamps[i]),
                      boxBlur(guides.colorB, radii[i], clamps[i]),
-                     boxBlur(guides.color, radii[i], clamps[i])});
+                     boxBlur(guides.color, radii[i], clamps[i]),
+                     {}});
+    for (const DenoiseInput& input : heldOut)
+      bases.back().heldOut.push_back(boxBlur(input.whole.color.mean, radii[i], clamps[i]));
+  }
   const auto pointers = pointersTo(bases);
   const double megapixels = double(size) * size / 1e6;
 
@@ -145,6 +153,9 @@ int main(int argc, char** argv) {
   };
   std::vector<Config> configs;
   configs.push_back({"default (summed, MSE window r=5, filter r=7)", {}});
+  CombineOptions halves;
+  halves.mse.estimate = MseEstimate::Halves;
+  configs.push_back({"halves estimate (else the defaults)", halves});
   CombineOptions perPixel;
   perPixel.mse.windowRadius = 0;
   configs.push_back({"per pixel (summed, window 0, filter r=7)", perPixel});

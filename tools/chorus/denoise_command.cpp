@@ -145,13 +145,14 @@ MemberRuns runAlone(ReadInput& input, const std::vector<std::string>& specs) {
   }
   std::vector<Image> images = runMembersAlone(full, members, &runs.times);
   for (size_t m = 0; m < members.size(); ++m)
-    runs.bases.push_back({members[m].label, {}, {}, std::move(images[m])});
+    runs.bases.push_back({members[m].label, {}, {}, std::move(images[m]), {}});
   return runs;
 }
 
-// Every member on half A, half B and the full buffer, for the combiners.
+// Every member on half A, half B and the full buffer (and the held-out inputs when the estimate
+// uses them), for the combiners.
 MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& specs,
-                          EnsembleGuides* guides) {
+                          const MseOptions& mse, EnsembleGuides* guides) {
   MemberRuns runs;
   if (input.outputs) {
     runs.bases = std::move(input.outputs->bases);
@@ -167,8 +168,9 @@ MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& spec
   } catch (const Error& e) {
     throw fileError(input.path, e.what() + inputHint(input, false));
   }
-  runs.bases = runBaseDenoisers(sources, members, &runs.times);
-  *guides = guidesFromSources(sources);
+  const bool heldOut = usesHeldOutRuns(mse, sources);
+  runs.bases = runBaseDenoisers(sources, members, &runs.times, heldOut);
+  *guides = guidesFromSources(sources, heldOut);
   return runs;
 }
 
@@ -260,7 +262,7 @@ void runDenoise(const DenoiseArgs& args) {
   }
 
   EnsembleGuides guides;
-  const MemberRuns runs = runForEnsemble(input, specs, &guides);
+  const MemberRuns runs = runForEnsemble(input, specs, options.mse, &guides);
   for (const StageTime& t : runs.times) times[t.stage] = t.seconds;
   checkEnsembleInputs(guides, pointersTo(runs.bases));
   ensureDirectory(out);

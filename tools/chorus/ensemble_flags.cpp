@@ -16,6 +16,12 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
   cmd.add_option("--mse", mseForm,
                  "MSE matrix per-channel (one weight per colour channel) or summed (one per pixel)")
       ->capture_default_str();
+  cmd.add_option("--estimate", estimate,
+                 "What the MSE estimate compares: halves (each member's runs on half A and B with "
+                 "the other half), quarters (its runs on three quarters with the fourth: "
+                 "4 more runs per member, needs 4 sub-buffers) or extrapolated (1.5 x quarters "
+                 "- 0.5 x halves)")
+      ->capture_default_str();
   cmd.add_option("--window", window,
                  "Radius of the feature-guided window the MSE estimate is accumulated over "
                  "(0 = per pixel, as in the paper)")
@@ -52,6 +58,11 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
                  "(0 = off, else at least 1)")
       ->capture_default_str()
       ->transform(zeroOrFiniteIn(1, kMaxEnsembleFactor));
+  cmd.add_option("--member-fallback", memberFallback,
+                 "Use the member closest to the noisy data where the blend's own error term "
+                 "exceeds K² times that member's plus the noise (0 = off, else at least 1)")
+      ->capture_default_str()
+      ->transform(zeroOrFiniteIn(1, kMaxEnsembleFactor));
   cmd.add_option("--solver-seed", seed, "Seed of the pairwise solver")
       ->capture_default_str()
       ->transform(anyUnsigned64());
@@ -66,6 +77,14 @@ CombineOptions EnsembleFlags::options() const {
     o.mse.form = MseForm::Summed;
   else
     throw Error("unknown --mse '" + mseForm + "' (known: per-channel, summed)");
+  if (estimate == "halves")
+    o.mse.estimate = MseEstimate::Halves;
+  else if (estimate == "quarters")
+    o.mse.estimate = MseEstimate::Quarters;
+  else if (estimate == "extrapolated")
+    o.mse.estimate = MseEstimate::Extrapolated;
+  else
+    throw Error("unknown --estimate '" + estimate + "' (known: halves, quarters, extrapolated)");
   // The numbers were range-checked when the flags were parsed (addFlags).
   o.mse.windowRadius = window;
   o.mse.relative = relative;
@@ -74,6 +93,7 @@ CombineOptions EnsembleFlags::options() const {
   o.mse.plausibility = plausibility;
   o.mse.imagePrior = imagePrior;
   o.mse.noisyFallback = noisyFallback;
+  o.mse.memberFallback = memberFallback;
   if (weightFilter != "bilateral" && weightFilter != "none")
     throw Error("unknown --weight-filter '" + weightFilter + "' (known: bilateral, none)");
   o.filter.enabled = weightFilter == "bilateral";

@@ -11,6 +11,7 @@ namespace chorus::cli {
 
 struct EnsembleFlags {
   std::string solver = "active-set", weightFilter = "bilateral", mseForm = "summed";
+  std::string estimate = estimateName(MseOptions{}.estimate);
   int window = MseOptions{}.windowRadius;
   bool relative = MseOptions{}.relative;
   double outlierCap = MseOptions{}.outlierCap;
@@ -18,6 +19,7 @@ struct EnsembleFlags {
   double plausibility = MseOptions{}.plausibility;
   double imagePrior = MseOptions{}.imagePrior;
   double noisyFallback = MseOptions{}.noisyFallback;
+  double memberFallback = MseOptions{}.memberFallback;
   uint64_t seed = 1;
 
   bool weightFilterGiven = false;  // --weight-filter was on the command line

@@ -50,6 +50,7 @@ nlohmann::ordered_json combineOptionsJson(const CombineOptions& o) {
   return {{"combine", combinerName(o.combiner)},
           {"solver", solverName(o.solver)},
           {"mse", o.mse.form == MseForm::Summed ? "summed" : "per-channel"},
+          {"estimate", estimateName(o.mse.estimate)},
           {"window", o.mse.windowRadius},
           {"relative", o.mse.relative},
           {"outlier_cap", o.mse.outlierCap},
@@ -57,6 +58,7 @@ nlohmann::ordered_json combineOptionsJson(const CombineOptions& o) {
           {"plausibility", o.mse.plausibility},
           {"image_prior", o.mse.imagePrior},
           {"noisy_fallback", o.mse.noisyFallback},
+          {"member_fallback", o.mse.memberFallback},
           {"weight_filter", o.filter.enabled ? "bilateral" : "none"},
           {"solver_seed", o.seed}};
 }

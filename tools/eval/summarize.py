@@ -246,12 +246,15 @@ def print_per_combination(cases, combos, out):
 
 def print_cases(cases, combo, out):
     chosen = [c for c in cases if c["combo"] == combo]
-    out.write("\nPer scene and spp, %s (relMSE; ratio = ensemble / best member)\n\n" % combo)
-    out.write("| scene | spp | best member | its relMSE | ensemble | ratio | one-hot pre | "
-              "one-hot post | oracle |\n|---|---|---|---|---|---|---|---|---|\n")
+    out.write("\nPer scene and spp, %s (relMSE; ratio = ensemble / best member; DSSIM: the "
+              "least of the members' and the ensemble's)\n\n" % combo)
+    out.write("| scene | spp | best member | its relMSE | ensemble | ratio | members' DSSIM | "
+              "ensemble DSSIM | one-hot pre | one-hot post | oracle |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|\n")
     for c in sorted(chosen, key=lambda c: (c["scene"], c["spp"])):
-        out.write("| %s | %d | %s | %.4g | %.4g | %.3f | %s | %s | %s |\n" % (
+        out.write("| %s | %d | %s | %.4g | %.4g | %.3f | %.4f | %.4f | %s | %s | %s |\n" % (
             c["scene"], c["spp"], c["best_name"], c["best"], c["ensemble"], ratio(c),
+            c["best_dssim"], c["ensemble_dssim"],
             *("%.4g" % c[k] if c[k] is not None else "–"
               for k in ("onehot-pre", "onehot-post", "oracle"))))
 
@@ -283,6 +286,25 @@ def summarize(main_rows, preview_rows, halves, half_of, cases_combos, out):
         print_member_check(member_vs_noisy(rows), out)
 
 
+def brief_line(label, half, main_rows, preview_rows, half_of):
+    """One line of the headline figures of a half (for comparing many variants)."""
+    rows = [r for r in main_rows if half_of.get(r["scene"]) == half]
+    preview = [r for r in preview_rows if half_of.get(r["scene"]) == half]
+    m = metrics(ensemble_cases(rows))
+    if not m["cases"]:
+        return "%s %s: no cases" % (label, half)
+    text = "%s %s: %d cases, beats %.1f%% (%s), worst %.2f, geo %.3f, dssim %.0f%%, " \
+           "pre %.0f%% post %.0f%% avg %.0f%%" % (
+               label, half, m["cases"], m["beats"],
+               " ".join("%.0f" % v for v, _ in m["per_spp"].values()), m["worst"], m["geomean"],
+               m["dssim"], m["onehot-pre"] or 0, m["onehot-post"] or 0, m["average"] or 0)
+    p = metrics(ensemble_cases(preview))
+    if p["cases"]:
+        text += " | preview beats %.0f%% worst %.2f geo %.3f dssim %.0f%%" % (
+            p["beats"], p["worst"], p["geomean"], p["dssim"])
+    return text
+
+
 def print_timings(directory, out):
     path = os.path.join(directory, "timings.tsv")
     if not os.path.exists(path):
@@ -310,6 +332,9 @@ def main(argv=None):
     parser.add_argument("--cases", action="append", default=[], metavar="COMBO",
                         help="also print the per scene/spp table of this combination, e.g. "
                         "nfor+rdfc+atrous, or 'preview' (repeatable)")
+    parser.add_argument("--brief", action="store_true",
+                        help="one line of headline figures per half (comparing variants)")
+    parser.add_argument("--label", default="", help="the --brief line's label")
     args = parser.parse_args(argv)
     try:
         if bool(args.dir) == bool(args.results):
@@ -331,6 +356,10 @@ def main(argv=None):
         print("summarize: %s" % e, file=sys.stderr)
         return 2
     halves = corpus_file.HALVES if args.half == "both" else (args.half,)
+    if args.brief:
+        for half in halves:
+            print(brief_line(args.label, half, main_rows, preview_rows, half_of))
+        return 0
     summarize(main_rows, preview_rows, halves, half_of, set(args.cases), sys.stdout)
     if args.dir:
         print_timings(args.dir, sys.stdout)

@@ -5,7 +5,6 @@
 // against the scene's expected value. Writes the rows of each spp as a sweep case
 // (OUT/cases/<name>_spp<N>.csv, the format of `chorus sweep`, so that summarize.py reads both
 // alike), resumes finished cases, and writes OUT/results.csv and report.html at the end.
-#include <tbb/parallel_for.h>
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -34,36 +33,10 @@ namespace {
 using namespace chorus;
 namespace fs = std::filesystem;
 
-// Per channel, the median of the 5×5 window clipped to the image: a member whose error has no
-// linear relation to its input's, unlike every filter of synthetic_cases.h.
-class Median5Denoiser : public BaseDenoiser {
- public:
-  std::string name() const override { return "median5"; }
-  DenoiserRequirements requirements() const override { return {}; }
-  Image run(const DenoiseInput& input) const override {
-    const Image& color = input.whole.color.mean;
-    const int w = color.width(), h = color.height();
-    Image out(w, h, 3);
-    tbb::parallel_for(0, h, [&](int y) {
-      std::array<float, 25> window{};
-      for (int x = 0; x < w; ++x)
-        for (int c = 0; c < 3; ++c) {
-          size_t n = 0;
-          for (int qy = std::max(0, y - 2); qy <= std::min(h - 1, y + 2); ++qy)
-            for (int qx = std::max(0, x - 2); qx <= std::min(w - 1, x + 2); ++qx)
-              window[n++] = color(qx, qy, c);
-          std::nth_element(window.begin(), window.begin() + n / 2, window.begin() + n);
-          out(x, y, c) = window[n / 2];
-        }
-    });
-    return out;
-  }
-};
-
 EnsembleMember member(const std::string& name) {
   if (name == "box3") return {name, synthetic::createSyntheticDenoiser("box1")};
   if (name == "gauss3") return {name, synthetic::createSyntheticDenoiser("gauss3")};
-  if (name == "median5") return {name, std::make_shared<Median5Denoiser>()};
+  if (name == "median5") return {name, synthetic::createSyntheticDenoiser("median5")};
   throw Error("--members: unknown member '" + name + "' (known: box3, gauss3, median5)");
 }
 

@@ -215,20 +215,21 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
   const EnsembleSources sources = sourcesFromBuffers(render.buffers);
   checkMembersCanRun(sources, plan.members);
   std::vector<StageTime> times;
-  const std::vector<BaseOutputs> bases = runBaseDenoisers(sources, plan.members, &times);
-  const EnsembleGuides guides = guidesFromSources(sources);
+  const bool heldOut = usesHeldOutRuns(config.combine.mse, sources);
+  const std::vector<BaseOutputs> bases = runBaseDenoisers(sources, plan.members, &times, heldOut);
+  const EnsembleGuides guides = guidesFromSources(sources, heldOut);
 
   // Times. A base denoiser alone costs one run on the full buffer (what a user running only it
-  // pays). A combination costs its members' runs on A, B and full plus the combine stages
-  // (solve, filter, blend): the base outputs are shared across combinations here, but a user
-  // running that one ensemble pays all of it. Runs are timed individually, so the figures are
-  // sequential costs even though the sweep runs the bases in parallel.
+  // pays). A combination costs its members' runs on A, B, full (and the held-out inputs) plus the
+  // combine stages (solve, filter, blend): the base outputs are shared across combinations here,
+  // but a user running that one ensemble pays all of it. Runs are timed individually, so the
+  // figures are sequential costs even though the sweep runs the bases in parallel.
   std::map<std::string, const BaseOutputs*> byName;
-  std::map<std::string, double> ensembleCost;  // member → A + B + full seconds
+  std::map<std::string, double> ensembleCost;  // member → every run of it (A, B, full, held out)
   for (const BaseOutputs& b : bases) {
     byName[b.name] = &b;
-    ensembleCost[b.name] = stageSeconds(times, b.name + "/A") + stageSeconds(times, b.name + "/B") +
-                           stageSeconds(times, b.name + "/full");
+    for (const StageTime& t : times)
+      if (t.stage.rfind(b.name + "/", 0) == 0) ensembleCost[b.name] += t.seconds;
   }
 
   CaseResult result;

@@ -1,0 +1,35 @@
+#include "denoise/pipeline/held_out_inputs.h"
+
+#include "common/error.h"
+
+namespace chorus {
+namespace {
+
+const SubBuffer& quarter(const EnsembleSources& sources, int k) {
+  return (k < 2 ? *sources.a.halves : *sources.b.halves)[size_t(k % 2)];
+}
+
+}  // namespace
+
+bool hasQuarters(const EnsembleSources& sources) {
+  return sources.a.halves.has_value() && sources.b.halves.has_value();
+}
+
+std::vector<DenoiseInput> heldOutInputs(const EnsembleSources& sources) {
+  if (!hasQuarters(sources))
+    throw Error(
+        "the leave-one-quarter-out estimate needs 4 independent sub-buffers (this input has "
+        "only 2)");
+  std::vector<DenoiseInput> inputs(kHeldOutQuarters);
+  for (int k = 0; k < kHeldOutQuarters; ++k) {
+    // The intact half (the other pair of quarters) and the quarter left of k's own pair.
+    const DenoiseInput& intact = k < 2 ? sources.b : sources.a;
+    const SubBuffer& single = quarter(sources, k ^ 1);
+    DenoiseInput& in = inputs[size_t(k)];
+    in.whole = merge({&single, &intact.whole});
+    in.halves = std::array<SubBuffer, 2>{single, intact.whole};
+  }
+  return inputs;
+}
+
+}  // namespace chorus

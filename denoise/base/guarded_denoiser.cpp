@@ -26,7 +26,8 @@ Image GuardedDenoiser::run(const DenoiseInput& input) const {
   const int exponent = radianceScaleExponent(guarded.input);
   scaleColor(guarded.input, -exponent);
   Image out = inner_->run(guarded.input);
-  keepWithinTheSamples(out, guarded.input.whole, kSampleSigmas);
+  // guard=0 leaves the member's own estimate alone (only the safety steps below remain).
+  if (guard_.ceilingSigmas > 0.0f) keepWithinTheSamples(out, guarded.input.whole, kSampleSigmas);
   finishOutput(out, guarded.input.whole.color.mean);
   scaleImage(out, exponent);
   // The input as given: the guard may have spread an excess onto such a pixel.

@@ -5,7 +5,7 @@
 //   3. radiance beyond float's comfortable range is divided by a power of two
 //      (radiance_scale.h) so that no squared term overflows, and multiplied back afterwards;
 //   4. the output stays within kSampleSigmas standard errors of each well-measured pixel's own
-//      mean (keepWithinTheSamples);
+//      mean (keepWithinTheSamples); with guard=0 (ceilingSigmas 0) steps 2 and 4 are off;
 //   5. the output is finite and not below min(0, input) at any pixel: non-finite values become
 //      the (guarded) noisy input's, and a member never makes non-negative radiance negative;
 //   6. pixels whose every sample missed the scene and agreed exactly keep their input.

@@ -1,8 +1,7 @@
 #!/usr/bin/env bash
 # One-command setup for a fresh Debian (bookworm) machine:
 #   tools/setup.sh demo   install missing packages, build, render the default scene with denoising
-#   tools/setup.sh test   install missing packages, build, run the whole test suite (CTest), then
-#                         the sanitize step below
+#   tools/setup.sh test   install missing packages, build, run the whole test suite (CTest)
 #   tools/setup.sh build  install missing packages and build only
 #   tools/setup.sh bench  also install the renderer benchmark's peer (embree-tools), build,
 #                         run build/bench/bench_render (about 3 minutes after the build)
@@ -10,7 +9,7 @@
 #                         AddressSanitizer and UBSan in build-asan/ (-O1) and run them, the fuzz
 #                         regression inputs included (docs/fuzzing.md)
 # Environment: BUILD_DIR (default build; build-asan for sanitize), JOBS (default: number of
-# cores), CI=true adds -Werror, SANITIZE=0 makes `test` skip the sanitize step.
+# cores), CI=true adds -Werror.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -62,11 +61,6 @@ case "$mode" in
   build) ;;
   test)
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
-    # Then the input-facing tests under AddressSanitizer + UBSan (docs/fuzzing.md); SANITIZE=0
-    # skips them.
-    if [ "${SANITIZE:-1}" != 0 ]; then
-      BUILD_DIR="$build_dir-asan" bash tools/setup.sh sanitize
-    fi
     ;;
   bench)
     "$build_dir"/bench/bench_render

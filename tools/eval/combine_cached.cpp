@@ -24,6 +24,7 @@
 #include "tools/chorus/ensemble_flags.h"
 #include "tools/chorus/render_denoise.h"
 #include "tools/eval/cached_case.h"
+#include "tools/eval/tool_main.h"
 #include "tools/sweep/sweep_directory.h"
 #include "tools/sweep/sweep_plan.h"
 #include "tools/sweep/sweep_results.h"
@@ -186,17 +187,5 @@ int main(int argc, char** argv) {
   app.add_flag("--full-from-held-out", args.fullFromHeldOut,
                "Replace each member's full-buffer output by the mean of its four held-out runs");
   args.ensemble.addFlags(app);
-  try {
-    app.parse(argc, argv);
-    run(args);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  } catch (const Error& e) {
-    std::cerr << "combine_cached: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "combine_cached: internal error: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+  return chorus::eval::parseAndRun(app, argc, argv, "combine_cached", [&] { run(args); });
 }

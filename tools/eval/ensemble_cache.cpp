@@ -27,6 +27,7 @@
 #include "denoise/pipeline/ensemble.h"
 #include "tests/support/synthetic_cases.h"
 #include "tools/eval/cached_case.h"
+#include "tools/eval/tool_main.h"
 
 namespace {
 
@@ -117,17 +118,5 @@ int main(int argc, char** argv) {
   app.add_option("--synthetic", args.synthetic,
                  "scene,size,seed,noise,firefly-rate,spp: write the synthetic render and truth");
   app.add_option("--threads", args.threads, "TBB threads (0: all cores)")->capture_default_str();
-  try {
-    app.parse(argc, argv);
-    run(args);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  } catch (const Error& e) {
-    std::cerr << "ensemble_cache: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "ensemble_cache: internal error: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+  return chorus::eval::parseAndRun(app, argc, argv, "ensemble_cache", [&] { run(args); });
 }

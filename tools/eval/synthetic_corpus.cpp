@@ -24,6 +24,7 @@
 #include "denoise/metrics/metrics.h"
 #include "denoise/pipeline/ensemble.h"
 #include "tests/support/synthetic_cases.h"
+#include "tools/eval/tool_main.h"
 #include "tools/sweep/sweep_directory.h"
 #include "tools/sweep/sweep_plan.h"
 #include "tools/sweep/sweep_results.h"
@@ -184,17 +185,5 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--threads", args.threads, "TBB threads (0: all cores)")->capture_default_str();
   app.add_option("--out", args.out, "Output folder")->required();
-  try {
-    app.parse(argc, argv);
-    run(args);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  } catch (const Error& e) {
-    std::cerr << "synthetic_corpus: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "synthetic_corpus: internal error: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+  return chorus::eval::parseAndRun(app, argc, argv, "synthetic_corpus", [&] { run(args); });
 }

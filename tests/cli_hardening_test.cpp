@@ -27,20 +27,13 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using test::cornellBox;
+using test::readJson;
 using test::runChorus;
 using test::TempDir;
 
-std::string cornellBox() {
-  return (test::sourceDir() / "scenes" / "cornell-box.gltf").string();
-}
-
 int lineCount(const std::string& s) {
   return int(std::count(s.begin(), s.end(), '\n'));
-}
-
-json readJson(const fs::path& file) {
-  std::ifstream in(file);
-  return json::parse(in);
 }
 
 // Exit code 2, one short line on stderr that names `named`, and no output directory.

@@ -24,16 +24,12 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using test::readJson;
 using test::runChorus;
 using test::TempDir;
 
 int lineCount(const std::string& s) {
   return int(std::count(s.begin(), s.end(), '\n'));
-}
-
-json readJson(const fs::path& path) {
-  std::ifstream in(path);
-  return json::parse(in);
 }
 
 std::vector<std::string> layerNames(const fs::path& path) {

@@ -16,17 +16,10 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using test::cornellBox;
+using test::readJson;
 using test::runChorus;
 using test::TempDir;
-
-std::string cornellBox() {
-  return (test::sourceDir() / "scenes" / "cornell-box.gltf").string();
-}
-
-json readJson(const fs::path& file) {
-  std::ifstream in(file);
-  return json::parse(in);
-}
 
 // The files in `dir` except the run's bookkeeping (.chorus-files), sorted.
 std::vector<std::string> filesIn(const fs::path& dir) {

@@ -102,4 +102,11 @@ Image randomImage(int width, int height, int channels, uint32_t seed, float lo, 
   return image;
 }
 
+std::string cornellBox() { return (sourceDir() / "scenes" / "cornell-box.gltf").string(); }
+
+nlohmann::json readJson(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  return nlohmann::json::parse(in);
+}
+
 }  // namespace chorus::test

@@ -3,6 +3,8 @@
 // subprocess, locating ../shared (skipping cleanly without it), and small synthetic images.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 #include <optional>
 #include <random>
@@ -41,6 +43,12 @@ ProcessResult runProgram(const std::filesystem::path& program, const std::vector
 
 // The project's source directory (for scenes/).
 std::filesystem::path sourceDir();
+
+// scenes/cornell-box.gltf of this source tree, as a command-line argument.
+std::string cornellBox();
+
+// The JSON document in `file` (stats.json and the like).
+nlohmann::json readJson(const std::filesystem::path& file);
 // ../shared next to the checkout (or $CHORUS_SHARED_DIR), when present.
 std::optional<std::filesystem::path> sharedDir();
 

@@ -13,6 +13,12 @@ PlanarImage sanitizedMean(const MeanVariance& quantity) {
   return out;
 }
 
+Image clampedFinite(const Image& image) {
+  Image out = image;
+  for (float& v : out.values()) v = clampedFinite(v);
+  return out;
+}
+
 PlanarImage sanitizedVarianceOfMean(const MeanVariance& quantity) {
   PlanarImage out(quantity.varianceOfMean);
   for (int c = 0; c < out.channels(); ++c) {

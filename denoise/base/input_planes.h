@@ -1,6 +1,9 @@
 #pragma once
 // Sanitised planar views of a SubBuffer for the filters: NaN/Inf never enter a filter, and
 // "no sample" is turned into "unknown" in a way each filter can handle.
+#include <algorithm>
+#include <cmath>
+
 #include "denoise/buffers/sample_buffers.h"
 #include "denoise/planes/planar_image.h"
 
@@ -12,6 +15,15 @@ inline constexpr float kUnknownVariance = 1e30f;
 
 // Colour mean with non-finite values replaced by 0.
 PlanarImage sanitizedMean(const MeanVariance& quantity);
+
+// Radiance beyond this is treated as this, so that squared differences stay finite in float.
+inline constexpr float kMaxFilterMagnitude = 1e12f;
+// A value clamped to ±kMaxFilterMagnitude, non-finite → 0.
+inline float clampedFinite(float v) {
+  return std::isfinite(v) ? std::clamp(v, -kMaxFilterMagnitude, kMaxFilterMagnitude) : 0.0f;
+}
+// An image with every value clamped by clampedFinite.
+Image clampedFinite(const Image& image);
 // Variance of the mean with non-finite or negative values replaced by 0 (colour: "noise-free").
 PlanarImage sanitizedVarianceOfMean(const MeanVariance& quantity);
 

@@ -8,14 +8,14 @@
 namespace chorus {
 namespace {
 
-std::string sizeText(const Image& image) {
+std::string shapeText(const Image& image) {
   return std::to_string(image.width()) + "x" + std::to_string(image.height()) + "x" +
          std::to_string(image.channels());
 }
 
 void checkImage(const Image& image, const std::string& what, const Image& like) {
   if (image.width() != like.width() || image.height() != like.height() || image.channels() != 3)
-    throw Error(what + " is " + sizeText(image) + ", expected " + std::to_string(like.width()) +
+    throw Error(what + " is " + shapeText(image) + ", expected " + std::to_string(like.width()) +
                 "x" + std::to_string(like.height()) + "x3");
 }
 

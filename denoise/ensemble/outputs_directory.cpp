@@ -9,7 +9,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string sizeText(const Image& image) {
+std::string pixelSizeText(const Image& image) {
   return std::to_string(image.width()) + "x" + std::to_string(image.height());
 }
 
@@ -26,7 +26,7 @@ Image readRgb(const fs::path& file, const Image& like) {
   if (image.channels() != 3)
     throw fileError(file, "has " + std::to_string(image.channels()) + " channels, expected 3");
   if (!like.empty() && !image.sameSize(like))
-    throw fileError(file, "is " + sizeText(image) + " but color.exr is " + sizeText(like));
+    throw fileError(file, "is " + pixelSizeText(image) + " but color.exr is " + pixelSizeText(like));
   return image;
 }
 

@@ -68,7 +68,7 @@ void runCompare(const CompareArgs& args) {
       m.mse, m.relMse, m.psnr, m.ssim, m.dssim, m.smape);
 }
 
-const RegisterCommand registration(10, [](CLI::App& app) {
+const RegisterCommand compareCommand(10, [](CLI::App& app) {
   auto args = std::make_shared<CompareArgs>();
   CLI::App* cmd = app.add_subcommand(
       "compare",

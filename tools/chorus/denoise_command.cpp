@@ -314,7 +314,7 @@ void runDenoise(const DenoiseArgs& args) {
   writeStats(out, stats, times, total);
 }
 
-const RegisterCommand registration(40, [](CLI::App& app) {
+const RegisterCommand denoiseCommand(40, [](CLI::App& app) {
   auto args = std::make_shared<DenoiseArgs>();
   CLI::App* cmd = app.add_subcommand(
       "denoise",

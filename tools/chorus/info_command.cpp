@@ -155,7 +155,7 @@ void runInfo(const std::string& path, const std::string& methods) {
   for (const std::string& w : scene.warnings) std::cerr << "chorus: warning: " << w << "\n";
 }
 
-const RegisterCommand registration(20, [](CLI::App& app) {
+const RegisterCommand infoCommand(20, [](CLI::App& app) {
   auto path = std::make_shared<std::string>();
   auto methods = std::make_shared<std::string>("default");
   CLI::App* cmd = app.add_subcommand(

@@ -189,7 +189,7 @@ void runRender(RenderArgs args) {
   }
 }
 
-const RegisterCommand registration(30, [](CLI::App& app) {
+const RegisterCommand renderCommand(30, [](CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand(
       "render",

@@ -139,7 +139,7 @@ void runSweepCommand(const SweepArgs& args) {
   printHeadline(config.out, sweep::readCsv(config.out / "results.csv"));
 }
 
-const RegisterCommand registration(50, [](CLI::App& app) {
+const RegisterCommand sweepCommand(50, [](CLI::App& app) {
   auto args = std::make_shared<SweepArgs>();
   CLI::App* cmd = app.add_subcommand(
       "sweep",

@@ -10,6 +10,7 @@
 #include <regex>
 #include <sstream>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/image/exr_io.h"
 
@@ -163,18 +164,6 @@ std::string valueFor(const CliFlag& flag, FuzzRandom& rng) {
 }
 
 // ---- fixtures --------------------------------------------------------------------------------
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void spit(const fs::path& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(bytes.data(), std::streamsize(bytes.size()));
-}
 
 std::vector<std::string> subcommands(const std::string& help) {
   std::vector<std::string> names;
@@ -376,9 +365,9 @@ CliFixtures prepareCliFixtures(const fs::path& chorus, const fs::path& sourceDir
   const fs::path scenes = sourceDir / "scenes";
   fs::copy_file(scenes / "cornell-box.gltf", dir / "scene.gltf");
   fs::copy_file(scenes / "cornell-box.bin", dir / "cornell-box.bin");
-  const std::string cornell = slurp(scenes / "cornell-box.gltf");
-  spit(dir / "broken.gltf", cornell.substr(0, cornell.size() / 2));
-  spit(dir / "text.txt", "not a scene\n");
+  const std::string cornell = readFileBytes(scenes / "cornell-box.gltf");
+  writeTextAtomically(dir / "broken.gltf", cornell.substr(0, cornell.size() / 2));
+  writeTextAtomically(dir / "text.txt", "not a scene\n");
   fs::copy_file(seedDir / "gltf" / "triangle.gltf", dir / "triangle.gltf");
   fs::copy_file(seedDir / "environment" / "rle.hdr", dir / "env.hdr");
   fs::copy_file(seedDir / "environment" / "sky.exr", dir / "sky.exr");
@@ -569,7 +558,7 @@ Outcome runCliCase(const FuzzCase& fuzzCase, const CliFixtures& fixtures, const 
     return outcome;
   }
   for (const fs::path& file : filesUnder(out)) {
-    if (file.extension() == ".csv" && std::regex_search(slurp(file), nonFinite)) {
+    if (file.extension() == ".csv" && std::regex_search(readFileBytes(file), nonFinite)) {
       outcome.summary =
           "exit 0 but " + fs::relative(file, caseDir).string() + " holds non-finite values";
       return outcome;

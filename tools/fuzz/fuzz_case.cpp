@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 
 namespace chorus::fuzz {
@@ -14,14 +15,6 @@ namespace fs = std::filesystem;
 namespace {
 constexpr std::string_view kFifoSuffix = ".mkfifo";
 constexpr std::string_view kArgsFile = "args.txt";
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw fileError(path, "cannot read");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 std::vector<std::string> lines(const std::string& text) {
   std::vector<std::string> result;
@@ -90,9 +83,9 @@ FuzzCase readCase(Target target, const fs::path& path) {
   result.target = target;
   if (fs::is_regular_file(path)) {
     if (path.filename() == kArgsFile) {
-      result.args = lines(slurp(path));
+      result.args = lines(readFileBytes(path));
     } else {
-      result.files.push_back({path.filename().string(), slurp(path)});
+      result.files.push_back({path.filename().string(), readFileBytes(path)});
     }
     return result;
   }
@@ -105,11 +98,11 @@ FuzzCase readCase(Target target, const fs::path& path) {
     const std::string name = fs::relative(file, path).string();
     if (name == "finding.txt" || name == "stderr.txt") continue;
     if (name == kArgsFile) {
-      result.args = lines(slurp(file));
+      result.args = lines(readFileBytes(file));
     } else if (name.ends_with(kFifoSuffix)) {
       result.files.push_back({name.substr(0, name.size() - kFifoSuffix.size()), "", true});
     } else {
-      result.files.push_back({name, slurp(file)});
+      result.files.push_back({name, readFileBytes(file)});
     }
   }
   return result;

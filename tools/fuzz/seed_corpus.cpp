@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/image/exr_io.h"
 #include "common/image/png_io.h"
@@ -22,20 +23,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw fileError(path, "cannot read seed");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void spit(const fs::path& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(bytes.data(), std::streamsize(bytes.size()));
-  if (!out) throw fileError(path, "cannot write seed");
-}
 
 std::string base64(const std::string& bytes) {
   static const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -167,9 +154,9 @@ std::string featuresGltf() {
 
 // The Cornell box as .glb: its JSON with the buffer moved into the BIN chunk.
 std::string cornellGlb(const fs::path& scenes) {
-  json doc = json::parse(slurp(scenes / "cornell-box.gltf"));
+  json doc = json::parse(readFileBytes(scenes / "cornell-box.gltf"));
   doc["buffers"][0].erase("uri");
-  return packGlb({doc.dump(), slurp(scenes / "cornell-box.bin")});
+  return packGlb({doc.dump(), readFileBytes(scenes / "cornell-box.bin")});
 }
 
 Image smoothImage(int width, int height, int channels, uint64_t seed) {
@@ -191,7 +178,7 @@ void writeTungstenDirectory(const fs::path& dir) {
       writeExr(dir / (name + suffix + ".exr"), smoothImage(4, 4, channelCount(q), seed++),
                ExrPixelType::Half);
   }
-  spit(dir / "meta.json", "{\"spp\": 8}\n");
+  writeTextAtomically(dir / "meta.json", "{\"spp\": 8}\n");
 }
 
 void writeRenderExr(const fs::path& path) {
@@ -212,9 +199,9 @@ void writeRenderExr(const fs::path& path) {
 // Everything that is not a copy of the project's scenes.
 void writeBuiltSeeds(const fs::path& sourceDir, const fs::path& dir) {
   fs::create_directories(dir / "gltf");
-  spit(dir / "gltf" / "triangle.gltf", triangleGltf());
-  spit(dir / "gltf" / "features.gltf", featuresGltf());
-  spit(dir / "gltf" / "cornell-box.glb", cornellGlb(sourceDir / "scenes"));
+  writeTextAtomically(dir / "gltf" / "triangle.gltf", triangleGltf());
+  writeTextAtomically(dir / "gltf" / "features.gltf", featuresGltf());
+  writeTextAtomically(dir / "gltf" / "cornell-box.glb", cornellGlb(sourceDir / "scenes"));
 
   fs::create_directories(dir / "exr");
   writeExr(dir / "exr" / "rgb.exr", smoothImage(8, 6, 3, 7));
@@ -224,16 +211,18 @@ void writeBuiltSeeds(const fs::path& sourceDir, const fs::path& dir) {
   writeTungstenDirectory(dir / "exr" / "tungsten");
 
   fs::create_directories(dir / "environment");
-  spit(dir / "environment" / "flat.hdr", radianceHdr(smoothImage(4, 3, 3, 10), false));
-  spit(dir / "environment" / "rle.hdr", radianceHdr(smoothImage(32, 8, 3, 11), true));
+  writeTextAtomically(dir / "environment" / "flat.hdr",
+                      radianceHdr(smoothImage(4, 3, 3, 10), false));
+  writeTextAtomically(dir / "environment" / "rle.hdr",
+                      radianceHdr(smoothImage(32, 8, 3, 11), true));
   Image runs(64, 4, 3, 0.5f);  // long runs, so that run packets appear
   runs(10, 1, 0) = 4.0f;
-  spit(dir / "environment" / "runs-rle.hdr", radianceHdr(runs, true));
+  writeTextAtomically(dir / "environment" / "runs-rle.hdr", radianceHdr(runs, true));
   writeExr(dir / "environment" / "sky.exr", smoothImage(16, 8, 3, 12), ExrPixelType::Half);
 }
 
 SeedInput singleFile(const fs::path& file) {
-  return {file.filename().string(), {{file.filename().string(), slurp(file)}}};
+  return {file.filename().string(), {{file.filename().string(), readFileBytes(file)}}};
 }
 
 }  // namespace
@@ -257,7 +246,7 @@ SeedCorpus buildSeedCorpus(const fs::path& sourceDir, const fs::path& dir) {
   for (const auto& entry : fs::directory_iterator(scenes)) {
     const std::string ext = entry.path().extension().string();
     if (ext == ".bin" || ext == ".png")
-      beside.push_back({entry.path().filename().string(), slurp(entry.path())});
+      beside.push_back({entry.path().filename().string(), readFileBytes(entry.path())});
   }
   std::vector<fs::path> gltfs;
   for (const auto& entry : fs::directory_iterator(scenes))
@@ -280,7 +269,7 @@ SeedCorpus buildSeedCorpus(const fs::path& sourceDir, const fs::path& dir) {
     files.push_back(entry.path());
   std::sort(files.begin(), files.end());
   for (const fs::path& file : files)
-    tungsten.files.push_back({file.filename().string(), slurp(file)});
+    tungsten.files.push_back({file.filename().string(), readFileBytes(file)});
   corpus.exr.push_back(std::move(tungsten));
   for (const char* name : {"flat.hdr", "rle.hdr", "runs-rle.hdr", "sky.exr"})
     corpus.environment.push_back(singleFile(dir / "environment" / name));

@@ -67,7 +67,7 @@ namespace {
 constexpr float kVarianceFloor = 0.01f;  // Li et al.'s release (c_VarMax)
 constexpr float kInverseFloor = 1.0f / kVarianceFloor;
 constexpr float kRangeEpsilon = 1e-10f;
-constexpr int kTileWidth = 128;
+constexpr int kBilateralTileWidth = 128;
 
 // e[i] += (fp − fq)² · (1 / max(vp + vq, floor)), four lanes at a time where SSE2 exists (the
 // compiler does not vectorise the max under default floating-point semantics); the scalar tail
@@ -154,7 +154,7 @@ void runPass(const PassInput& in, PassOutput& out) {
     out.rangeB.assign(size_t(candidates), PlanarImage(w, h, planes));
   }
   const float twoSigmaC2 = 2.0f * in.sigmaC * in.sigmaC;
-  const int tilesPerRow = (w + kTileWidth - 1) / kTileWidth;
+  const int tilesPerRow = (w + kBilateralTileWidth - 1) / kBilateralTileWidth;
 
   // Largest feature variance per row tile, over the tile widened by the window radius.
   std::vector<std::vector<float>> tileMaxVariance(size_t(features),
@@ -163,8 +163,8 @@ void runPass(const PassInput& in, PassOutput& out) {
     for (int k = 0; k < features; ++k)
       for (int t = 0; t < tilesPerRow; ++t) {
         const float* v = guide.variance.row(k, y);
-        const int lo = std::max(0, t * kTileWidth - maxRadius);
-        const int hi = std::min(w, (t + 1) * kTileWidth + maxRadius);
+        const int lo = std::max(0, t * kBilateralTileWidth - maxRadius);
+        const int hi = std::min(w, (t + 1) * kBilateralTileWidth + maxRadius);
         tileMaxVariance[size_t(k)][size_t(y * tilesPerRow + t)] = *std::max_element(v + lo, v + hi);
       }
   });
@@ -173,18 +173,18 @@ void runPass(const PassInput& in, PassOutput& out) {
       tbb::blocked_range<int>(0, h * tilesPerRow), [&](const tbb::blocked_range<int>& tiles) {
         const FlushDenormals flush;  // tiny weights × the spatial Gaussian would be denormal
         Scratch s;
-        s.exponent.resize(kTileWidth);
-        s.weight.resize(kTileWidth);
-        s.t.assign(size_t(rangeChannels), std::vector<float>(kTileWidth));
+        s.exponent.resize(kBilateralTileWidth);
+        s.weight.resize(kBilateralTileWidth);
+        s.t.assign(size_t(rangeChannels), std::vector<float>(kBilateralTileWidth));
         const size_t accPlanes = size_t(candidates * planes);
-        s.sums.assign(accPlanes, std::vector<float>(kTileWidth));
-        s.weightSum.assign(size_t(candidates), std::vector<float>(kTileWidth));
-        s.rangeA.assign(range ? accPlanes : 0, std::vector<float>(kTileWidth));
-        s.rangeB.assign(range ? accPlanes : 0, std::vector<float>(kTileWidth));
+        s.sums.assign(accPlanes, std::vector<float>(kBilateralTileWidth));
+        s.weightSum.assign(size_t(candidates), std::vector<float>(kBilateralTileWidth));
+        s.rangeA.assign(range ? accPlanes : 0, std::vector<float>(kBilateralTileWidth));
+        s.rangeB.assign(range ? accPlanes : 0, std::vector<float>(kBilateralTileWidth));
 
         for (int tile = tiles.begin(); tile < tiles.end(); ++tile) {
           const int y = tile / tilesPerRow, tileX = tile % tilesPerRow;
-          const int x0 = tileX * kTileWidth, x1 = std::min(w, x0 + kTileWidth);
+          const int x0 = tileX * kBilateralTileWidth, x1 = std::min(w, x0 + kBilateralTileWidth);
           for (auto* group : {&s.sums, &s.weightSum, &s.rangeA, &s.rangeB})
             for (auto& v : *group) std::fill(v.begin(), v.end(), 0.0f);
 

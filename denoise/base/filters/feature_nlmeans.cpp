@@ -24,7 +24,7 @@ namespace {
 // the tile grown by f + box (5 for RDFC) are 1.36× the tile. In the AVX-512 build, which
 // contracts FMAs in the vector loops only, a pixel's column within a row decides whether its
 // value comes from the vector loop or the scalar tail, so the width changes results by rounding.
-constexpr int kTileWidth = 256, kTileHeight = 32;
+constexpr int kFeatureTileWidth = 256, kFeatureTileHeight = 32;
 constexpr float kSymmetricLimit = 25.0f;  // refine only where both distances are below this
 enum Kind { kPlus, kMinus, kSym };
 
@@ -313,11 +313,11 @@ void FeatureNlMeansKernel::runTile(const PixelRect& tile, TileMemory& m,
   const FlushDenormals flush;  // tiny weights times data would be denormal
   const size_t area = size_t(tile.area());
   const int tw = tile.width(), x0 = tile.x0;
-  const size_t gridArea = size_t(kTileWidth + 2 * box_) * size_t(kTileHeight + 2 * box_);
+  const size_t gridArea = size_t(kFeatureTileWidth + 2 * box_) * size_t(kFeatureTileHeight + 2 * box_);
   const size_t extArea =
-      size_t(kTileWidth + 2 * (box_ + f_)) * size_t(kTileHeight + 2 * (box_ + f_));
+      size_t(kFeatureTileWidth + 2 * (box_ + f_)) * size_t(kFeatureTileHeight + 2 * (box_ + f_));
   m.ones.assign(extArea, 1.0f);
-  for (auto& v : m.termRow) v.resize(kTileWidth);
+  for (auto& v : m.termRow) v.resize(kFeatureTileWidth);
   for (auto& v : m.ext) v.resize(extArea);
   for (auto& v : m.dist) v.resize(gridArea);
   for (auto& v : m.gridMaskStore) v.resize(extArea);
@@ -380,9 +380,9 @@ std::vector<Image> FeatureNlMeansKernel::run() const {
   for (size_t d = 0; d + 1 < dataBegin_.size(); ++d)
     out.emplace_back(width_, height_, dataBegin_[d + 1] - dataBegin_[d]);
   std::vector<PixelRect> tiles;
-  for (int y = 0; y < height_; y += kTileHeight)
-    for (int x = 0; x < width_; x += kTileWidth)
-      tiles.push_back({x, y, std::min(width_, x + kTileWidth), std::min(height_, y + kTileHeight)});
+  for (int y = 0; y < height_; y += kFeatureTileHeight)
+    for (int x = 0; x < width_; x += kFeatureTileWidth)
+      tiles.push_back({x, y, std::min(width_, x + kFeatureTileWidth), std::min(height_, y + kFeatureTileHeight)});
   tbb::enumerable_thread_specific<TileMemory> memory;
   tbb::parallel_for(size_t(0), tiles.size(),
                     [&](size_t t) { runTile(tiles[t], memory.local(), out); });

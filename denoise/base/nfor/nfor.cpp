@@ -10,6 +10,7 @@
 #include "denoise/base/filters/collaborative_regression.h"
 #include "denoise/base/filters/local_range.h"
 #include "denoise/base/filters/nlmeans_filter.h"
+#include "denoise/base/input_planes.h"
 #include "denoise/base/variance_estimates.h"
 
 namespace chorus {
@@ -45,21 +46,9 @@ NforParams NforParams::fromParams(ParamMap& map) {
 
 namespace {
 
-// Radiance beyond this is treated as this, so that squared errors stay finite in float.
-constexpr float kMaxMagnitude = 1e12f;
 // How far beyond its window's data range (in units of that range) a regression's prediction
 // may go before the NL-means average replaces it.
 constexpr float kImplausibleMargin = 0.5f;
-
-float sanitizeValue(float v) {
-  return std::isfinite(v) ? std::clamp(v, -kMaxMagnitude, kMaxMagnitude) : 0.0f;
-}
-
-Image sanitized(const Image& image) {
-  Image out = image;
-  for (float& v : out.values()) v = sanitizeValue(v);
-  return out;
-}
 
 // Tungsten's feature order: depth, albedo R G B, normal x y z, visibility.
 constexpr Quantity kFeatureOrder[] = {Quantity::Depth, Quantity::Albedo, Quantity::Normal,
@@ -80,7 +69,7 @@ Image featureMeans(const SubBuffer& buffer) {
     const Image& mean = buffer.get(q).mean;
     for (int c = 0; c < mean.channels(); ++c, ++channel)
       for (int y = 0; y < out.height(); ++y)
-        for (int x = 0; x < out.width(); ++x) out(x, y, channel) = sanitizeValue(mean(x, y, c));
+        for (int x = 0; x < out.width(); ++x) out(x, y, channel) = clampedFinite(mean(x, y, c));
   }
   return out;
 }
@@ -127,8 +116,8 @@ class NforRun {
 
   Image run() {
     const auto& halves = *input_.halves;
-    const Image c1 = sanitized(halves[0].color.mean), c2 = sanitized(halves[1].color.mean);
-    const Image c = sanitized(input_.whole.color.mean);
+    const Image c1 = clampedFinite(halves[0].color.mean), c2 = clampedFinite(halves[1].color.mean);
+    const Image c = clampedFinite(input_.whole.color.mean);
     const Image sigma2 = colorVariance(input_);
 
     // Feature cross-prefiltering (§5.1): A's features with weights from B's, and vice versa.

@@ -6,6 +6,7 @@
 
 #include "common/error.h"
 #include "denoise/base/filters/nlmeans_filter.h"
+#include "denoise/base/input_planes.h"
 #include "denoise/base/variance_estimates.h"
 
 namespace chorus {
@@ -36,16 +37,6 @@ namespace {
 // nothing: the smoothing of Δ becomes a plain patchwise box).
 constexpr float kUninformativeScale = 1e6f;
 
-// Radiance beyond this is treated as this, so that squared differences stay finite in float.
-constexpr float kMaxMagnitude = 1e12f;
-
-Image sanitized(const Image& image) {
-  Image out = image;
-  for (float& v : out.values())
-    v = std::isfinite(v) ? std::clamp(v, -kMaxMagnitude, kMaxMagnitude) : 0.0f;
-  return out;
-}
-
 // Per-sample variance s = v · n (v where the count is unknown).
 Image perSampleVariance(const Image& varianceOfMean, const Image& count) {
   Image out = varianceOfMean;
@@ -66,12 +57,12 @@ Image DualBufferNlMeans::run(const DenoiseInput& input) const {
     throw Error("nlm: needs two independent halves of its input (render with 2 or 4 sub-buffers)");
   const DualBufferNlMeansParams& p = params_;
   const auto& halves = *input.halves;
-  const Image a = sanitized(halves[0].color.mean), b = sanitized(halves[1].color.mean);
+  const Image a = clampedFinite(halves[0].color.mean), b = clampedFinite(halves[1].color.mean);
   const int w = a.width(), h = a.height(), channels = a.channels();
 
   // Variance of each half's mean; the two-buffer fallback where a half has a single sample.
-  const Image vA = sanitized(halfVarianceOfMean(input, 0, Quantity::Color));
-  const Image vB = sanitized(halfVarianceOfMean(input, 1, Quantity::Color));
+  const Image vA = clampedFinite(halfVarianceOfMean(input, 0, Quantity::Color));
+  const Image vB = clampedFinite(halfVarianceOfMean(input, 1, Quantity::Color));
   const Image& nA = halves[0].sampleCount;
   const Image& nB = halves[1].sampleCount;
   const bool counts = nA.sameSize(a) && nB.sameSize(b);

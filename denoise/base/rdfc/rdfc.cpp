@@ -12,8 +12,6 @@
 namespace chorus {
 namespace {
 
-constexpr float kMinCenterWeight = 1e-3f;
-
 void requireRange(bool ok, const std::string& what) {
   if (!ok) throw Error("rdfc: " + what);
 }
@@ -27,7 +25,7 @@ std::vector<Image> colorNlMeans(std::span<const Image* const> data, const Image&
                         .f = params.selectionF,
                         .k = params.selectionK,
                         .weightBoxRadius = params.selectionBoxRadius};
-  return featureNlMeans(data, &patch, {}, {.r = r, .minCenterWeight = kMinCenterWeight});
+  return featureNlMeans(data, &patch, {}, {.r = r, .minCenterWeight = kRdfcMinCenterWeight});
 }
 
 // Step 4: smoothed SURE maps, argmin with RDFC's rules, smoothed binary maps.
@@ -112,7 +110,7 @@ Image secondPass(const Image& first1, const Image& first2, const std::vector<Rdf
   }
   const Image* data[] = {&first1, &first2};
   const std::vector<Image> filtered = featureNlMeans(
-      data, &patch, featureTerms, {.r = params.secondR, .minCenterWeight = kMinCenterWeight});
+      data, &patch, featureTerms, {.r = params.secondR, .minCenterWeight = kRdfcMinCenterWeight});
   return meanOf(filtered[0], filtered[1]);
 }
 

@@ -27,8 +27,7 @@ namespace {
 // at 256 × 4 on the synthetic 512² case). 16 rows: the margin rows' colour distances and patch
 // sums favour taller tiles (−2.6% instructions from 16 to 32), but the tile's ~80 planes then
 // outgrow L2 (32 rows 2–4% slower in A/B runs, 8 rows 1–3%).
-constexpr int kTileWidth = 256, kTileHeight = 16;
-constexpr float kMinCenterWeight = 1e-3f;  // the release's WEIGHT_EPSILON
+constexpr int kCandidateTileWidth = 256, kCandidateTileHeight = 16;
 constexpr float kSymmetricLimit = 25.0f;   // refine only where both distances are below this
 constexpr int kColor = 2;                  // FIRST and SECOND have a colour term
 enum Kind { kPlus, kMinus, kSym };
@@ -364,7 +363,7 @@ void CandidateKernel::finishTile(const PixelRect& tile, const TileMemory& m, Out
     for (int x = tile.x0; x < tile.x1; ++x) {
       const size_t i = size_t(y - tile.y0) * size_t(tile.width()) + size_t(x - tile.x0);
       for (int s = 0; s < 3; ++s) {
-        const float centre = std::max(m.maxWeight[s][i], kMinCenterWeight);
+        const float centre = std::max(m.maxWeight[s][i], kRdfcMinCenterWeight);
         const float total = m.weightSum[s][i] + centre;
         float mean[3];
         for (int c = 0; c < 3; ++c) {
@@ -383,7 +382,7 @@ void CandidateKernel::finishTile(const PixelRect& tile, const TileMemory& m, Out
           for (int c = 0; c < 3 && valid; ++c) {
             const size_t k = size_t(c) * stride + i;
             const float dCentre =
-                m.maxWeight[s][i] >= kMinCenterWeight ? m.maxDerivative[s][k] : 0.0f;
+                m.maxWeight[s][i] >= kRdfcMinCenterWeight ? m.maxDerivative[s][k] : 0.0f;
             const float dSum = m.derivativeSum[s][k] + dCentre;
             const float dAcc = m.derivativeAcc[s][k] + dCentre * guide_(x, y, c) + centre;
             der[c] = (dAcc - mean[c] * dSum) / total;
@@ -400,7 +399,7 @@ void CandidateKernel::finishTile(const PixelRect& tile, const TileMemory& m, Out
 void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out) const {
   const FlushDenormals flush;  // tiny weights times data would be denormal
   const size_t area = size_t(tile.area());
-  const size_t grownArea = size_t(kTileWidth + 2 * grow_) * size_t(kTileHeight + 2 * grow_);
+  const size_t grownArea = size_t(kCandidateTileWidth + 2 * grow_) * size_t(kCandidateTileHeight + 2 * grow_);
   m.planeStride = paddedPlaneStride(area);
   const size_t plane = m.planeStride;  // every plane's allocation, so that they too are staggered
   m.ones.assign(area, 1.0f);
@@ -409,14 +408,14 @@ void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out
     m.featMinus[set].resize(plane);
   }
   for (auto& v : m.ext) v.resize(grownArea);
-  m.rowSums.resize(size_t(kTileWidth) * size_t(kTileHeight + 2 * grow_));
-  m.invCountX.resize(kTileWidth);
-  m.innerSums.resize(size_t(kTileWidth + 2 * grow_ + 2) * size_t(kTileHeight + 2 * grow_));
-  m.invY.resize(kTileHeight);
-  m.running.resize(kTileWidth);
+  m.rowSums.resize(size_t(kCandidateTileWidth) * size_t(kCandidateTileHeight + 2 * grow_));
+  m.invCountX.resize(kCandidateTileWidth);
+  m.innerSums.resize(size_t(kCandidateTileWidth + 2 * grow_ + 2) * size_t(kCandidateTileHeight + 2 * grow_));
+  m.invY.resize(kCandidateTileHeight);
+  m.running.resize(kCandidateTileWidth);
   for (int s = 0; s < kColor; ++s) {
     const float inv = 1.0f / float(2 * patch_[s] + 1);
-    m.fullInvCountX[s].assign(kTileWidth, inv);
+    m.fullInvCountX[s].assign(kCandidateTileWidth, inv);
     m.fullInvCount[s].assign(plane, inv * inv);
   }
   for (int s = 0; s < kColor; ++s)
@@ -451,9 +450,9 @@ void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out
 
 std::array<RdfcCandidate, 3> CandidateKernel::run() const {
   std::vector<PixelRect> tiles;
-  for (int y = 0; y < height_; y += kTileHeight)
-    for (int x = 0; x < width_; x += kTileWidth)
-      tiles.push_back({x, y, std::min(width_, x + kTileWidth), std::min(height_, y + kTileHeight)});
+  for (int y = 0; y < height_; y += kCandidateTileHeight)
+    for (int x = 0; x < width_; x += kCandidateTileWidth)
+      tiles.push_back({x, y, std::min(width_, x + kCandidateTileWidth), std::min(height_, y + kCandidateTileHeight)});
   Outputs out;
   for (int s = 0; s < 3; ++s) {
     out.buffer1[size_t(s)] = Image(width_, height_, 3);

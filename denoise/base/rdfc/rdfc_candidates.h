@@ -31,6 +31,9 @@
 
 namespace chorus {
 
+// A pixel's own weight in every RDFC filter is at least this (the release's WEIGHT_EPSILON).
+inline constexpr float kRdfcMinCenterWeight = 1e-3f;
+
 struct RdfcCandidateParams {
   int r = 10;                    // window radius of all three candidates
   float kc = 0.45f;              // k_c of FIRST and SECOND

@@ -19,8 +19,10 @@
 // comes after the includes, and every helper the kernels inline is defined below it (GCC does
 // not inline across different optimisation options).
 #pragma GCC optimize("fp-contract=off")
-// Helpers pass 64-byte vectors by value; they are internal and inlined, so the baseline ABI's
-// note that such values go through memory without AVX-512 does not matter.
+// Helpers pass 64-byte vectors by value, so every one is always_inline: an out-of-line copy is
+// compiled for the baseline ISA, whose ABI passes such values differently from the AVX-512 clone
+// that calls it (at -O0, where nothing else is inlined, that read through a null pointer:
+// tests/fuzz/cli/sweep-nfor-at-O0).
 #pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace chorus {
@@ -40,26 +42,26 @@ using Lanes = float __attribute__((vector_size(kLanes * sizeof(float))));
 // tolerance) has to drop the column — which Tungsten's QR on √W X keeps. The products of
 // float inputs w · x_a are exact in double.
 using SumLanes = double __attribute__((vector_size(kLanes * sizeof(double))));
-inline SumLanes wide(Lanes v) {
+[[gnu::always_inline]] inline SumLanes wide(Lanes v) {
   return __builtin_convertvector(v, SumLanes);
 }
 
-inline Lanes loadLanes(const float* p) {
+[[gnu::always_inline]] inline Lanes loadLanes(const float* p) {
   Lanes v;
   std::memcpy(&v, p, sizeof v);
   return v;
 }
 
-inline void storeLanes(float* p, Lanes v) {
+[[gnu::always_inline]] inline void storeLanes(float* p, Lanes v) {
   std::memcpy(p, &v, sizeof v);
 }
 
-inline Lanes splat(float v) {
+[[gnu::always_inline]] inline Lanes splat(float v) {
   return Lanes{} + v;
 }
 
 // Whether every lane is +0 (weights are never negative): the bits OR-folded in halves.
-inline bool allZero(Lanes v) {
+[[gnu::always_inline]] inline bool allZero(Lanes v) {
   using Bits16 = uint32_t __attribute__((vector_size(16 * sizeof(uint32_t))));
   static_assert(sizeof(Bits16) == sizeof(Lanes));
   const Bits16 b16 = (Bits16)v;  // the same bits (a vector conversion between equal sizes)

@@ -1,6 +1,8 @@
 #pragma once
 // Wall-clock seconds since construction (or the last restart), for stage timings in stats.json,
-// sweep tables and benchmarks.
+// sweep tables and benchmarks; and the process's CPU time, for the benchmarks.
+#include <time.h>
+
 #include <chrono>
 
 namespace chorus {
@@ -22,5 +24,12 @@ class Stopwatch {
  private:
   std::chrono::steady_clock::time_point start_;
 };
+
+// CPU seconds (user + system) of every thread of this process so far.
+inline double processCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 }  // namespace chorus

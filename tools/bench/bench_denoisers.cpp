@@ -26,7 +26,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -36,6 +35,7 @@
 
 #include "common/error.h"
 #include "common/image/exr_io.h"
+#include "common/stopwatch.h"
 #include "common/memory_reuse.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/tungsten_dir.h"
@@ -157,12 +157,6 @@ std::vector<BenchCase> peerCases() {
 struct Timing {
   double wallSeconds = 0, cpuSeconds = 0;
 };
-
-double processCpuSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
 
 Timing timeRun(const BaseDenoiser& denoiser, const DenoiseInput& input, Image& output) {
   const double cpuStart = processCpuSeconds();

@@ -18,7 +18,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -26,6 +25,7 @@
 #include "common/error.h"
 #include "common/image/exr_io.h"
 #include "common/memory_reuse.h"
+#include "common/stopwatch.h"
 #include "denoise/base/nfor/nfor.h"
 #include "denoise/base/nlm/dual_buffer_nlm.h"
 #include "denoise/base/rdfc/rdfc.h"
@@ -66,12 +66,6 @@ DenoiseInput tiled(const DenoiseInput& in, int size) {
   out.halves =
       std::array<SubBuffer, 2>{tiled(in.halves->at(0), size), tiled(in.halves->at(1), size)};
   return out;
-}
-
-double processCpuSeconds() {
-  timespec t;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 struct Timing {

@@ -5,7 +5,6 @@
 // scenes/cornell-box.gltf at 512×512 by default. The target is ≤ 1.0 s wall on 2 cores. Then the
 // relMSE it reaches against a high-spp reference (cached with --reference-cache), next to the noisy
 // input and the full default ensemble (`chorus render`'s default members) at the same spp.
-#include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <CLI/CLI.hpp>
 
@@ -29,13 +28,6 @@ namespace {
 
 using namespace chorus;
 
-double cpuSeconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
 struct Run {
   double wall = 0, cpu = 0, render = 0, bases = 0, combine = 0, png = 0;
   Image image, noisy;
@@ -44,7 +36,7 @@ struct Run {
 Run runOnce(const render::Scene& scene, const render::RenderOptions& options,
             const Ensemble& ensemble) {
   Run run;
-  const double cpu0 = cpuSeconds();
+  const double cpu0 = processCpuSeconds();
   Stopwatch total, stage;
   render::RenderResult rendered = render::render(scene, options);
   const EnsembleSources sources =
@@ -57,7 +49,7 @@ Run runOnce(const render::Scene& scene, const render::RenderOptions& options,
   const std::vector<uint8_t> png = encodePng(result.combined.image);
   run.png = stage.restart();
   run.wall = total.seconds();
-  run.cpu = cpuSeconds() - cpu0;
+  run.cpu = processCpuSeconds() - cpu0;
   run.image = result.combined.image;
   run.noisy = result.guides.color;
   return run;

@@ -35,13 +35,6 @@ namespace {
 
 using namespace chorus;
 
-double cpuSeconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
 double peakRssMiB() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
@@ -66,11 +59,11 @@ Timing timeDenoise(const render::Scene& scene, int size, int spp, int threads,
   const EnsembleSources sources =
       sourcesFromBuffers(std::move(rendered.buffers), readsHalves(ensemble.members()));
   Timing t;
-  const double cpu0 = cpuSeconds();
+  const double cpu0 = processCpuSeconds();
   const Stopwatch wall;
   const EnsembleResult result = ensemble.run(sources);
   t.wall = wall.seconds();
-  t.cpu = cpuSeconds() - cpu0;
+  t.cpu = processCpuSeconds() - cpu0;
   for (const StageTime& s : result.times)
     if (s.stage == "bases") t.bases = s.seconds;
   t.combine = t.wall - t.bases;

@@ -190,7 +190,9 @@ TEST(RenderCli, FailsCleanlyOnBadInput) {
   expectCleanFailure({"render", scene.string(), "--denoise", "atrous,foo", "--out", o},
                      "unknown denoiser 'foo'", out);
   expectCleanFailure({"render", scene.string(), "--denoise", "jnlm:k=x", "--out", o},
-                     "denoiser jnlm: parameter k=x is not a number", out);
+                     "denoiser jnlm: parameter k=x is not a finite number", out);
+  expectCleanFailure({"render", scene.string(), "--denoise", "nlm:alpha=nan", "--out", o},
+                     "denoiser nlm: parameter alpha=nan is not a finite number", out);
   expectCleanFailure({"render", scene.string(), "--splits", "2", "--out", o},
                      "--denoise nfor,rdfc,atrous needs 4 sub-buffers", out);
   expectCleanFailure({"render", scene.string(), "--combine", "oracle", "--out", o},

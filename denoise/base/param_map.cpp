@@ -1,6 +1,7 @@
 #include "denoise/base/param_map.h"
 
 #include <charconv>
+#include <cmath>
 #include <sstream>
 
 #include "common/error.h"
@@ -34,10 +35,10 @@ float ParamMap::getFloat(const std::string& key, float defaultValue) {
   try {
     size_t used = 0;
     const float value = std::stof(*v, &used);
-    if (used == v->size()) return value;
+    if (used == v->size() && std::isfinite(value)) return value;
   } catch (const std::exception&) {
   }
-  throw Error("parameter " + key + "=" + *v + " is not a number");
+  throw Error("parameter " + key + "=" + *v + " is not a finite number");
 }
 
 int ParamMap::getInt(const std::string& key, int defaultValue) {

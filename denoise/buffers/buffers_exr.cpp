@@ -1,5 +1,6 @@
 #include "denoise/buffers/buffers_exr.h"
 
+#include <cmath>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -77,6 +78,12 @@ SubBuffer readSubBuffer(const std::vector<ExrLayer>& layers, const std::string& 
     }
   }
   sub.sampleCount = requirePlane(layers, prefix + "sampleCount", 1, file);
+  // Counts weigh the sub-buffers when they are merged: a negative or non-finite one (a corrupt
+  // or hand-edited file) would turn every merged mean into nonsense.
+  for (const float n : sub.sampleCount.values())
+    if (!(n >= 0.0f) || !std::isfinite(n))
+      throw fileError(file, "layer '" + prefix + "sampleCount' holds " + std::to_string(n) +
+                                ", not a sample count");
   return sub;
 }
 

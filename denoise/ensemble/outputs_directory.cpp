@@ -26,7 +26,8 @@ Image readRgb(const fs::path& file, const Image& like) {
   if (image.channels() != 3)
     throw fileError(file, "has " + std::to_string(image.channels()) + " channels, expected 3");
   if (!like.empty() && !image.sameSize(like))
-    throw fileError(file, "is " + pixelSizeText(image) + " but color.exr is " + pixelSizeText(like));
+    throw fileError(file,
+                    "is " + pixelSizeText(image) + " but color.exr is " + pixelSizeText(like));
   return image;
 }
 

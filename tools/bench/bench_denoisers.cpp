@@ -35,8 +35,8 @@
 
 #include "common/error.h"
 #include "common/image/exr_io.h"
-#include "common/stopwatch.h"
 #include "common/memory_reuse.h"
+#include "common/stopwatch.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/tungsten_dir.h"
 #include "denoise/metrics/metrics.h"

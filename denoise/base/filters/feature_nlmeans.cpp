@@ -313,7 +313,8 @@ void FeatureNlMeansKernel::runTile(const PixelRect& tile, TileMemory& m,
   const FlushDenormals flush;  // tiny weights times data would be denormal
   const size_t area = size_t(tile.area());
   const int tw = tile.width(), x0 = tile.x0;
-  const size_t gridArea = size_t(kFeatureTileWidth + 2 * box_) * size_t(kFeatureTileHeight + 2 * box_);
+  const size_t gridArea =
+      size_t(kFeatureTileWidth + 2 * box_) * size_t(kFeatureTileHeight + 2 * box_);
   const size_t extArea =
       size_t(kFeatureTileWidth + 2 * (box_ + f_)) * size_t(kFeatureTileHeight + 2 * (box_ + f_));
   m.ones.assign(extArea, 1.0f);
@@ -382,7 +383,8 @@ std::vector<Image> FeatureNlMeansKernel::run() const {
   std::vector<PixelRect> tiles;
   for (int y = 0; y < height_; y += kFeatureTileHeight)
     for (int x = 0; x < width_; x += kFeatureTileWidth)
-      tiles.push_back({x, y, std::min(width_, x + kFeatureTileWidth), std::min(height_, y + kFeatureTileHeight)});
+      tiles.push_back({x, y, std::min(width_, x + kFeatureTileWidth),
+                       std::min(height_, y + kFeatureTileHeight)});
   tbb::enumerable_thread_specific<TileMemory> memory;
   tbb::parallel_for(size_t(0), tiles.size(),
                     [&](size_t t) { runTile(tiles[t], memory.local(), out); });

@@ -28,8 +28,8 @@ namespace {
 // sums favour taller tiles (−2.6% instructions from 16 to 32), but the tile's ~80 planes then
 // outgrow L2 (32 rows 2–4% slower in A/B runs, 8 rows 1–3%).
 constexpr int kCandidateTileWidth = 256, kCandidateTileHeight = 16;
-constexpr float kSymmetricLimit = 25.0f;   // refine only where both distances are below this
-constexpr int kColor = 2;                  // FIRST and SECOND have a colour term
+constexpr float kSymmetricLimit = 25.0f;  // refine only where both distances are below this
+constexpr int kColor = 2;                 // FIRST and SECOND have a colour term
 enum Kind { kPlus, kMinus, kSym };
 
 struct TileMemory {
@@ -399,7 +399,8 @@ void CandidateKernel::finishTile(const PixelRect& tile, const TileMemory& m, Out
 void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out) const {
   const FlushDenormals flush;  // tiny weights times data would be denormal
   const size_t area = size_t(tile.area());
-  const size_t grownArea = size_t(kCandidateTileWidth + 2 * grow_) * size_t(kCandidateTileHeight + 2 * grow_);
+  const size_t grownArea =
+      size_t(kCandidateTileWidth + 2 * grow_) * size_t(kCandidateTileHeight + 2 * grow_);
   m.planeStride = paddedPlaneStride(area);
   const size_t plane = m.planeStride;  // every plane's allocation, so that they too are staggered
   m.ones.assign(area, 1.0f);
@@ -410,7 +411,8 @@ void CandidateKernel::runTile(const PixelRect& tile, TileMemory& m, Outputs& out
   for (auto& v : m.ext) v.resize(grownArea);
   m.rowSums.resize(size_t(kCandidateTileWidth) * size_t(kCandidateTileHeight + 2 * grow_));
   m.invCountX.resize(kCandidateTileWidth);
-  m.innerSums.resize(size_t(kCandidateTileWidth + 2 * grow_ + 2) * size_t(kCandidateTileHeight + 2 * grow_));
+  m.innerSums.resize(size_t(kCandidateTileWidth + 2 * grow_ + 2) *
+                     size_t(kCandidateTileHeight + 2 * grow_));
   m.invY.resize(kCandidateTileHeight);
   m.running.resize(kCandidateTileWidth);
   for (int s = 0; s < kColor; ++s) {
@@ -452,7 +454,8 @@ std::array<RdfcCandidate, 3> CandidateKernel::run() const {
   std::vector<PixelRect> tiles;
   for (int y = 0; y < height_; y += kCandidateTileHeight)
     for (int x = 0; x < width_; x += kCandidateTileWidth)
-      tiles.push_back({x, y, std::min(width_, x + kCandidateTileWidth), std::min(height_, y + kCandidateTileHeight)});
+      tiles.push_back({x, y, std::min(width_, x + kCandidateTileWidth),
+                       std::min(height_, y + kCandidateTileHeight)});
   Outputs out;
   for (int s = 0; s < 3; ++s) {
     out.buffer1[size_t(s)] = Image(width_, height_, 3);

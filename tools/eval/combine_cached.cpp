@@ -42,24 +42,6 @@ struct Args {
   cli::EnsembleFlags ensemble;
 };
 
-sweep::SweepRow row(const std::string& scene, int spp, const std::string& method,
-                    const std::string& combiner, int members, const Image& image,
-                    const Image& reference, double seconds) {
-  const ImageMetrics m = computeMetrics(image, reference);
-  sweep::SweepRow r;
-  r.scene = scene;
-  r.spp = spp;
-  r.method = method;
-  r.combiner = combiner;
-  r.members = members;
-  r.relMse = m.relMse;
-  r.dssim = m.dssim;
-  r.psnr = m.psnr;
-  r.smape = m.smape;
-  r.denoiseSeconds = r.totalSeconds = seconds;
-  return r;
-}
-
 // The rows of one case: noisy, every member, every combination × combiner.
 std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir, int spp,
                                       const std::vector<std::string>& methods,
@@ -80,9 +62,9 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
       }
   }
   std::vector<sweep::SweepRow> rows = {
-      row(args.name, spp, "noisy", "-", 0, guides.color, reference, 0)};
+      sweep::measuredRow(args.name, spp, "noisy", "-", 0, guides.color, reference, 0, 0)};
   for (const std::string& m : methods)
-    rows.push_back(row(args.name, spp, m, "-", 1, alone[m], reference, 0));
+    rows.push_back(sweep::measuredRow(args.name, spp, m, "-", 1, alone[m], reference, 0, 0));
   for (const std::string& combo : combos) {
     std::vector<const BaseOutputs*> chosen;
     for (const std::string& m : sweep::splitCombination(combo)) chosen.push_back(&outputs.at(m));
@@ -92,8 +74,8 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
       const CombineResult result = combine(guides, chosen, options, &reference);
       double seconds = 0;
       for (const StageTime& t : result.times) seconds += t.seconds;
-      rows.push_back(
-          row(args.name, spp, combo, name, int(chosen.size()), result.image, reference, seconds));
+      rows.push_back(sweep::measuredRow(args.name, spp, combo, name, int(chosen.size()),
+                                        result.image, reference, 0, seconds));
     }
   }
   return rows;

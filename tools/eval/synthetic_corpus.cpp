@@ -66,25 +66,6 @@ std::string settingsText(const Args& a) {
   return text;
 }
 
-sweep::SweepRow row(const sweep::SweepCase& c, const std::string& method,
-                    const std::string& combiner, int members, const Image& image,
-                    const Image& truth, double seconds) {
-  const ImageMetrics m = computeMetrics(image, truth);
-  sweep::SweepRow r;
-  r.scene = c.scene;
-  r.spp = c.spp;
-  r.method = method;
-  r.combiner = combiner;
-  r.members = members;
-  r.relMse = m.relMse;
-  r.dssim = m.dssim;
-  r.psnr = m.psnr;
-  r.smape = m.smape;
-  r.denoiseSeconds = seconds;
-  r.totalSeconds = seconds;
-  return r;
-}
-
 std::vector<sweep::SweepRow> runCase(const Args& args, const sweep::SweepCase& c,
                                      const std::vector<EnsembleMember>& members,
                                      const std::vector<std::string>& combos,
@@ -101,8 +82,10 @@ std::vector<sweep::SweepRow> runCase(const Args& args, const sweep::SweepCase& c
   const std::vector<BaseOutputs> bases = runBaseDenoisers(sources, members, &times);
   const EnsembleGuides guides = guidesFromSources(sources);
 
-  std::vector<sweep::SweepRow> rows = {row(c, "noisy", "-", 0, guides.color, truth, 0)};
-  for (const BaseOutputs& b : bases) rows.push_back(row(c, b.name, "-", 1, b.full, truth, 0));
+  std::vector<sweep::SweepRow> rows = {
+      sweep::measuredRow(c.scene, c.spp, "noisy", "-", 0, guides.color, truth, 0, 0)};
+  for (const BaseOutputs& b : bases)
+    rows.push_back(sweep::measuredRow(c.scene, c.spp, b.name, "-", 1, b.full, truth, 0, 0));
   for (const std::string& combo : combos) {
     std::vector<const BaseOutputs*> chosen;
     for (const std::string& name : sweep::splitCombination(combo))
@@ -114,8 +97,9 @@ std::vector<sweep::SweepRow> runCase(const Args& args, const sweep::SweepCase& c
       const Stopwatch time;
       const CombineResult result =
           combine(guides, chosen, options, needsReference(combiner) ? &truth : nullptr);
-      rows.push_back(row(c, combo, std::string(combinerName(combiner)), int(chosen.size()),
-                         result.image, truth, time.seconds()));
+      rows.push_back(sweep::measuredRow(c.scene, c.spp, combo, std::string(combinerName(combiner)),
+                                        int(chosen.size()), result.image, truth, 0,
+                                        time.seconds()));
     }
   }
   return rows;

@@ -228,35 +228,34 @@ std::string GltfEditor::targetedField(FuzzRandom& rng) {
   return at.to_string() + " = " + shown;
 }
 
-std::string GltfEditor::deleteKey(FuzzRandom& rng) {
+std::optional<std::pair<Pointer, std::string>> GltfEditor::pickKey(FuzzRandom& rng) const {
   const Sites sites = sitesOf(doc_);
   for (int attempt = 0; attempt < 8; ++attempt) {
     const Pointer& at = rng.pick(sites.objects);
-    json& object = doc_[at];
+    const json& object = doc_[at];
     if (object.empty()) continue;
     auto it = object.begin();
     std::advance(it, rng.below(object.size()));
-    const std::string key = it.key();
-    object.erase(key);
-    return "delete " + (at / key).to_string();
+    return std::pair{at, it.key()};
   }
-  return "delete nothing";
+  return std::nullopt;
+}
+
+std::string GltfEditor::deleteKey(FuzzRandom& rng) {
+  const auto picked = pickKey(rng);
+  if (!picked) return "delete nothing";
+  const auto& [at, key] = *picked;
+  doc_[at].erase(key);
+  return "delete " + (at / key).to_string();
 }
 
 std::string GltfEditor::duplicateKey(FuzzRandom& rng) {
-  const Sites sites = sitesOf(doc_);
-  for (int attempt = 0; attempt < 8; ++attempt) {
-    const Pointer& at = rng.pick(sites.objects);
-    json& object = doc_[at];
-    if (object.empty()) continue;
-    auto it = object.begin();
-    std::advance(it, rng.below(object.size()));
-    const std::string key = it.key();
-    // The placeholder key becomes a second "key" in the text (JSON objects cannot hold two).
-    object[placeholder("\"" + key + "\"")] = randomValue(rng, key);
-    return "duplicate key " + (at / key).to_string();
-  }
-  return "duplicate nothing";
+  const auto picked = pickKey(rng);
+  if (!picked) return "duplicate nothing";
+  const auto& [at, key] = *picked;
+  // The placeholder key becomes a second "key" in the text (JSON objects cannot hold two).
+  doc_[at][placeholder("\"" + key + "\"")] = randomValue(rng, key);
+  return "duplicate key " + (at / key).to_string();
 }
 
 std::string GltfEditor::editArray(FuzzRandom& rng) {

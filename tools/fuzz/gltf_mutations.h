@@ -12,6 +12,7 @@
 // a hostile document itself.
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -48,6 +49,9 @@ class GltfEditor {
   // A string that text() replaces, quotes included, by `literal`.
   std::string placeholder(std::string literal);
   nlohmann::json randomValue(FuzzRandom& rng, const std::string& key);
+  // A random key of a random non-empty object (up to 8 tries), with the object's pointer.
+  std::optional<std::pair<nlohmann::json::json_pointer, std::string>> pickKey(
+      FuzzRandom& rng) const;
 
   nlohmann::json doc_;
   std::vector<std::pair<std::string, std::string>> literals_;  // placeholder → literal

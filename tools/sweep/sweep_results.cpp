@@ -6,8 +6,29 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "denoise/metrics/metrics.h"
 
 namespace chorus::sweep {
+
+SweepRow measuredRow(const std::string& scene, int spp, const std::string& method,
+                     const std::string& combiner, int members, const Image& image,
+                     const Image& reference, double renderSeconds, double denoiseSeconds) {
+  const ImageMetrics m = computeMetrics(image, reference);
+  SweepRow row;
+  row.scene = scene;
+  row.spp = spp;
+  row.method = method;
+  row.combiner = combiner;
+  row.members = members;
+  row.relMse = m.relMse;
+  row.dssim = m.dssim;
+  row.psnr = m.psnr;
+  row.smape = m.smape;
+  row.renderSeconds = renderSeconds;
+  row.denoiseSeconds = denoiseSeconds;
+  row.totalSeconds = renderSeconds + denoiseSeconds;
+  return row;
+}
 
 namespace {
 

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "common/image/image.h"
+
 namespace chorus::sweep {
 
 struct SweepRow {
@@ -20,6 +22,11 @@ struct SweepRow {
   // "nfor+rdfc / ensemble", or just "nfor" for a single base denoiser.
   std::string label() const;
 };
+
+// A row with the metrics of `image` against `reference`; total seconds = render + denoise.
+SweepRow measuredRow(const std::string& scene, int spp, const std::string& method,
+                     const std::string& combiner, int members, const Image& image,
+                     const Image& reference, double renderSeconds, double denoiseSeconds);
 
 // The CSV header line (no trailing newline) and the text of a whole table.
 std::string csvHeader();

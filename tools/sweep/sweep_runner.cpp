@@ -156,26 +156,6 @@ fs::path obtainReference(const SweepConfig& config, size_t sceneIndex, const std
   return cached;
 }
 
-SweepRow makeRow(const SweepCase& c, const std::string& method, const std::string& combiner,
-                 int members, const Image& image, const Image& reference, double renderSeconds,
-                 double denoiseSeconds) {
-  const ImageMetrics m = computeMetrics(image, reference);
-  SweepRow row;
-  row.scene = c.scene;
-  row.spp = c.spp;
-  row.method = method;
-  row.combiner = combiner;
-  row.members = members;
-  row.relMse = m.relMse;
-  row.dssim = m.dssim;
-  row.psnr = m.psnr;
-  row.smape = m.smape;
-  row.renderSeconds = renderSeconds;
-  row.denoiseSeconds = denoiseSeconds;
-  row.totalSeconds = renderSeconds + denoiseSeconds;
-  return row;
-}
-
 double stageSeconds(const std::vector<StageTime>& times, const std::string& stage) {
   for (const StageTime& t : times)
     if (t.stage == stage) return t.seconds;
@@ -233,10 +213,11 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
   }
 
   CaseResult result;
-  result.rows.push_back(makeRow(c, "noisy", "-", 0, guides.color, reference, renderSeconds, 0));
+  result.rows.push_back(
+      measuredRow(c.scene, c.spp, "noisy", "-", 0, guides.color, reference, renderSeconds, 0));
   for (const BaseOutputs& b : bases)
-    result.rows.push_back(makeRow(c, b.name, "-", 1, b.full, reference, renderSeconds,
-                                  stageSeconds(times, b.name + "/full")));
+    result.rows.push_back(measuredRow(c.scene, c.spp, b.name, "-", 1, b.full, reference,
+                                      renderSeconds, stageSeconds(times, b.name + "/full")));
 
   const CropWindow window = worstWindow(guides.color, reference, config.cropSize);
   auto cropPng = [&](const Image& image) { return encodePng(cropImage(image, window)); };
@@ -259,9 +240,9 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
           combine(guides, members, combineOptions, needsReference(combiner) ? &reference : nullptr);
       double seconds = membersSeconds;
       for (const StageTime& t : combined.times) seconds += t.seconds;
-      result.rows.push_back(makeRow(c, plan.combos[i], std::string(combinerName(combiner)),
-                                    int(members.size()), combined.image, reference, renderSeconds,
-                                    seconds));
+      result.rows.push_back(measuredRow(c.scene, c.spp, plan.combos[i],
+                                        std::string(combinerName(combiner)), int(members.size()),
+                                        combined.image, reference, renderSeconds, seconds));
       if (i == plan.largestCombo && combiner == Combiner::Ensemble) {
         result.crops.images.push_back(
             {"ensemble (" + plan.combos[i] + ")", cropPng(combined.image)});

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "denoise/ensemble/blend.h"
 #include "denoise/ensemble/mse_estimate.h"
 #include "denoise/metrics/metrics.h"
 #include "tests/support/test_support.h"
@@ -332,6 +333,47 @@ TEST(MseEstimate, LeaveOneQuarterOutIsUnbiasedForTheThreeQuarterRuns) {
     EXPECT_LT(biasOverSeeds(radius, false, MseEstimate::Quarters).worstZ, 3.0) << radius;
   // Negative control: held-out runs that saw their quarter.
   EXPECT_GT(biasOverSeeds(0, true, MseEstimate::Quarters).worstZ, 10.0);
+}
+
+// The blend's estimated MSE (the mseEstimate layer) from the half blends and from the held-out
+// blends, for fixed weights and members with known errors: m1 = the mean of the samples,
+// m2 = ½ m1 + ½ c (biased towards c). With w = (0.3, 0.7) the blend is
+// (w1 + ½w2)·mean + ½w2·c, whose error is (½w2 (c − μ))² + (w1 + ½w2)² σ²_run, with σ²_run =
+// σ_q²/2 for a half and σ_q²/3 for three quarters. The image mean of each estimate (64k
+// i.i.d. pixels × 3 channels) is within 3 % of that value.
+TEST(MseEstimate, BlendMseEstimatesMatchTheAnalyticError) {
+  const int w = 256, h = 256;
+  const double mu = 2.0, c = 3.0, sigmaQ = 0.8, w1 = 0.3, w2 = 0.7;
+  std::mt19937 rng(77);
+  std::normal_distribution<double> noise(0.0, sigmaQ);
+  std::vector<Image> quarters(4, Image(w, h, 3));
+  for (Image& q : quarters)
+    for (float& v : q.values()) v = float(mu + noise(rng));
+  const auto blendOf = [&](double mean) { return w1 * mean + w2 * (0.5 * mean + 0.5 * c); };
+  Image zA(w, h, 3), zB(w, h, 3), xA(w, h, 3), xB(w, h, 3);
+  std::vector<Image> heldOut(4, Image(w, h, 3));
+  for (size_t e = 0; e < zA.size(); ++e) {
+    double x[4], sum = 0;
+    for (size_t k = 0; k < 4; ++k) sum += x[k] = quarters[k].data()[e];
+    xA.data()[e] = float(0.5 * (x[0] + x[1]));
+    xB.data()[e] = float(0.5 * (x[2] + x[3]));
+    zA.data()[e] = float(blendOf(xA.data()[e]));
+    zB.data()[e] = float(blendOf(xB.data()[e]));
+    for (size_t k = 0; k < 4; ++k) heldOut[k].data()[e] = float(blendOf((sum - x[k]) / 3.0));
+  }
+  const double bias2 = std::pow(0.5 * w2 * (c - mu), 2), gain2 = std::pow(w1 + 0.5 * w2, 2);
+  const double halfError = bias2 + gain2 * sigmaQ * sigmaQ / 2;
+  const double threeQuarterError = bias2 + gain2 * sigmaQ * sigmaQ / 3;
+  const auto mean = [](const Image& image) {
+    double sum = 0;
+    for (float v : image.values()) sum += v;
+    return sum / double(image.size());
+  };
+  EXPECT_NEAR(mean(estimatedBlendMse(zA, zB, xA, xB)), halfError, 0.03 * halfError);
+  EXPECT_NEAR(mean(heldOutBlendMse(heldOut, quarters)), threeQuarterError,
+              0.03 * threeQuarterError);
+  // The two differ by more than the tolerance, so each test tells them apart.
+  EXPECT_GT(halfError - threeQuarterError, 0.1 * threeQuarterError);
 }
 
 TEST(MseEstimate, OracleIsTheTrueErrorMatrix) {

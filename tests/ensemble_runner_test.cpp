@@ -1,5 +1,5 @@
-// The Ensemble runner: runs every member on half A, half B and the full buffer (exactly what
-// running the denoiser on SampleBuffers::input(part) gives), combines, reports every stage's
+// The Ensemble runner: runs every member on the full buffer and on half A and half B or the four
+// held-out inputs (exactly what running the denoiser on those inputs gives), combines, reports every stage's
 // time, refuses members that cannot run on the given sub-buffers, and is deterministic.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -10,6 +10,7 @@
 #include "common/error.h"
 #include "denoise/metrics/metrics.h"
 #include "denoise/pipeline/ensemble.h"
+#include "denoise/pipeline/held_out_inputs.h"
 #include "tests/support/synthetic_cases.h"
 
 namespace chorus {
@@ -71,9 +72,24 @@ bool sameImage(const Image& a, const Image& b) {
   return a.sameShape(b) && std::equal(a.values().begin(), a.values().end(), b.values().begin());
 }
 
+CombineOptions withEstimate(MseEstimate estimate) {
+  CombineOptions options;
+  options.mse.estimate = estimate;
+  return options;
+}
+
+std::set<std::string> stagesOf(const EnsembleResult& result) {
+  std::set<std::string> stages;
+  for (const StageTime& t : result.times) {
+    stages.insert(t.stage);
+    EXPECT_GE(t.seconds, 0.0);
+  }
+  return stages;
+}
+
 TEST(EnsembleRunner, RunsEveryMemberOnHalfAHalfBAndFull) {
   const SampleBuffers b = buffers(4);
-  const Ensemble ensemble(boxMembers(), {});
+  const Ensemble ensemble(boxMembers(), withEstimate(MseEstimate::Halves));
   const EnsembleResult result = ensemble.run(b);
   ASSERT_EQ(result.bases.size(), 2u);
   const BoxDenoiser box1(1), box3(3);
@@ -84,23 +100,57 @@ TEST(EnsembleRunner, RunsEveryMemberOnHalfAHalfBAndFull) {
   // The guides are the noisy halves, and the combination is combine() on those outputs.
   EXPECT_TRUE(sameImage(result.guides.colorA, b.part(BufferPart::HalfA).color.mean));
   EXPECT_TRUE(sameImage(result.guides.colorB, b.part(BufferPart::HalfB).color.mean));
-  const CombineResult direct = combine(result.guides, pointersTo(result.bases), {});
+  const CombineResult direct =
+      combine(result.guides, pointersTo(result.bases), ensemble.options());
   EXPECT_TRUE(sameImage(result.combined.image, direct.image));
+  EXPECT_TRUE(result.bases[0].heldOut.empty());
   // Every stage is timed.
-  std::set<std::string> stages;
-  for (const StageTime& t : result.times) {
-    stages.insert(t.stage);
-    EXPECT_GE(t.seconds, 0.0);
-  }
+  const std::set<std::string> stages = stagesOf(result);
   for (const char* stage : {"box1/A", "box1/B", "box1/full", "box3/A", "box3/B", "box3/full",
                             "bases", "solve", "filter", "blend"})
     EXPECT_TRUE(stages.count(stage)) << stage;
 }
 
+// The quarters estimate (the default) on K = 4: the full run and the four held-out runs, no
+// half runs; the blend's A/B images are left out and its estimated MSE comes from the folds.
+// The extrapolated estimate needs both.
+TEST(EnsembleRunner, TheQuartersEstimateRunsTheHeldOutInputsInsteadOfTheHalves) {
+  const SampleBuffers b = buffers(4);
+  const Ensemble ensemble(boxMembers(), {});
+  const EnsembleResult result = ensemble.run(b);
+  const std::vector<DenoiseInput> heldOut = heldOutInputs(sourcesFromBuffers(b));
+  const BoxDenoiser box3(3);
+  ASSERT_EQ(result.bases[1].heldOut.size(), 4u);
+  for (size_t k = 0; k < 4; ++k)
+    EXPECT_TRUE(sameImage(result.bases[1].heldOut[k], box3.run(heldOut[k]))) << k;
+  EXPECT_TRUE(sameImage(result.bases[1].full, box3.run(b.input(BufferPart::Full))));
+  EXPECT_FALSE(result.bases[0].hasHalfRuns());
+  EXPECT_TRUE(result.combined.imageA.empty() && result.combined.imageB.empty());
+  EXPECT_TRUE(result.combined.mseEstimate.sameShape(result.combined.image));
+  const std::set<std::string> stages = stagesOf(result);
+  EXPECT_EQ(stages.count("box1/A") + stages.count("box3/B"), 0u);
+  for (const char* stage : {"box1/full", "box1/without-q0", "box3/without-q3", "bases", "solve",
+                            "filter", "blend"})
+    EXPECT_TRUE(stages.count(stage)) << stage;
+  // Combining the same runs with the halves estimate is refused in one line.
+  EXPECT_THROW(combine(result.guides, pointersTo(result.bases),
+                       withEstimate(MseEstimate::Extrapolated)),
+               Error);
+
+  const EnsembleResult both = Ensemble(boxMembers(), withEstimate(MseEstimate::Extrapolated)).run(b);
+  EXPECT_TRUE(both.bases[0].hasHalfRuns());
+  EXPECT_EQ(both.bases[0].heldOut.size(), 4u);
+  EXPECT_FALSE(both.combined.imageA.empty());
+  // K = 2 has no quarters: the half runs, whatever the estimate asks for.
+  const EnsembleResult two = ensemble.run(buffers(2));
+  EXPECT_TRUE(two.bases[0].hasHalfRuns());
+  EXPECT_TRUE(two.bases[0].heldOut.empty());
+}
+
 TEST(EnsembleRunner, HalvesOfTheirOwnInputNeedFourSubBuffers) {
   std::vector<EnsembleMember> members = boxMembers();
   members.push_back({"halves", std::make_shared<HalvesDenoiser>()});
-  const Ensemble ensemble(members, {});
+  const Ensemble ensemble(members, withEstimate(MseEstimate::Halves));
   // K = 4: the half runs get quarters as their halves.
   const SampleBuffers four = buffers(4);
   const EnsembleResult result = ensemble.run(four);

@@ -59,4 +59,27 @@ Image estimatedBlendMse(const Image& blendA, const Image& blendB, const Image& c
   return out;
 }
 
+Image heldOutBlendMse(std::span<const Image> heldOutBlends, std::span<const Image> quarters) {
+  if (heldOutBlends.size() != 4 || quarters.size() != 4)
+    throw Error("heldOutBlendMse: expected four held-out blends and four quarters");
+  const Image& like = quarters[0];
+  for (size_t k = 0; k < 4; ++k)
+    if (!heldOutBlends[k].sameShape(like) || !quarters[k].sameShape(like))
+      throw Error("heldOutBlendMse: images differ in shape");
+  Image out(like.width(), like.height(), like.channels());
+  for (size_t e = 0; e < out.size(); ++e) {
+    double mean = 0, error = 0;
+    for (size_t k = 0; k < 4; ++k) mean += 0.25 * quarters[k].data()[e];
+    double spread = 0;
+    for (size_t k = 0; k < 4; ++k) {
+      const double x = quarters[k].data()[e], d = heldOutBlends[k].data()[e] - x;
+      error += 0.25 * d * d;
+      spread += (x - mean) * (x - mean) / 3.0;
+    }
+    const double value = error - spread;
+    out.data()[e] = std::isfinite(float(value)) ? float(value) : 0.0f;
+  }
+  return out;
+}
+
 }  // namespace chorus

@@ -26,4 +26,11 @@ Image blend(std::span<const Image> weights, std::span<const Image* const> output
 Image estimatedBlendMse(const Image& blendA, const Image& blendB, const Image& colorA,
                         const Image& colorB);
 
+// The same from the leave-one-quarter-out blends z^(−k) (the weights applied to the runs
+// without quarter k) and the noisy quarters x_k, k = 0 … 3:
+//   mean_k (z^(−k) − x_k)² − s²,  s² = (1/3) Σ_k (x_k − x̄)²  (the variance of a quarter mean).
+// Unbiased for the mean of the three-quarter blends' squared errors under the same condition;
+// may be negative; non-finite values are written as 0.
+Image heldOutBlendMse(std::span<const Image> heldOutBlends, std::span<const Image> quarters);
+
 }  // namespace chorus

@@ -160,14 +160,46 @@ std::vector<const Image*> outputsOf(std::span<const BaseOutputs* const> bases,
   return images;
 }
 
+// The noisy mean of every quarter but k at element e: the noisy counterpart of the runs
+// without quarter k.
+float quarterMeanWithout(const EnsembleGuides& guides, size_t k, size_t e) {
+  float sum = 0;
+  for (size_t j = 0; j < 4; ++j)
+    if (j != k) sum += guides.quarters[j].data()[e];
+  return sum / 3.0f;
+}
+
+Image quartersWithout(const EnsembleGuides& guides, size_t k) {
+  Image out(guides.width(), guides.height(), 3);
+  for (size_t e = 0; e < out.size(); ++e) out.data()[e] = quarterMeanWithout(guides, k, e);
+  return out;
+}
+
+// The weights applied to every run: full buffer, and the half runs (a, b) or, where the bases
+// have none, the held-out runs.
 struct Blends {
   Image full, a, b;
+  std::vector<Image> heldOut;
+
+  ColorGuide colorGuide(const WeightFilterOptions& options) const {
+    return heldOut.empty() ? makeColorGuide(full, a, b, options)
+                           : makeColorGuide(full, heldOut, options);
+  }
 };
 Blends blendAll(const std::vector<Image>& weights, std::span<const BaseOutputs* const> bases,
                 const EnsembleGuides& guides) {
-  return {blend(weights, outputsOf(bases, &BaseOutputs::full), guides.color),
-          blend(weights, outputsOf(bases, &BaseOutputs::a), guides.colorA),
-          blend(weights, outputsOf(bases, &BaseOutputs::b), guides.colorB)};
+  Blends blends{blend(weights, outputsOf(bases, &BaseOutputs::full), guides.color), {}, {}, {}};
+  if (bases[0]->hasHalfRuns()) {
+    blends.a = blend(weights, outputsOf(bases, &BaseOutputs::a), guides.colorA);
+    blends.b = blend(weights, outputsOf(bases, &BaseOutputs::b), guides.colorB);
+    return blends;
+  }
+  for (size_t k = 0; k < 4; ++k) {
+    std::vector<const Image*> runs;
+    for (const BaseOutputs* base : bases) runs.push_back(&base->heldOut[k]);
+    blends.heldOut.push_back(blend(weights, runs, quartersWithout(guides, k)));
+  }
+  return blends;
 }
 
 // Weight filter step shared by the combiners: guided by the blend of `weights`.
@@ -176,8 +208,7 @@ std::vector<Image> filterWeights(const std::vector<Image>& weights,
                                  std::span<const BaseOutputs* const> bases,
                                  const EnsembleGuides& guides, const WeightFilterOptions& options,
                                  bool nonNegative) {
-  const Blends raw = blendAll(weights, bases, guides);
-  const ColorGuide guide = makeColorGuide(raw.full, raw.a, raw.b, options);
+  const ColorGuide guide = blendAll(weights, bases, guides).colorGuide(options);
   const std::vector<Image> filtered =
       crossBilateralFilter(weights, guide, guides.normal, guides.albedo, options);
   return renormalizeWeights(filtered, valid, weights, nonNegative);
@@ -294,9 +325,8 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
         // Guided by the average blend: the combiner has no weights before this step.
         std::vector<Image> uniform = zeroMaps(n, w, h, 1);
         for (Image& map : uniform) map.fill(1.0f / float(n));
-        const Blends average = blendAll(uniform, bases, guides);
         diagonal.maps = crossBilateralFilter(
-            diagonal.maps, makeColorGuide(average.full, average.a, average.b, options.filter),
+            diagonal.maps, blendAll(uniform, bases, guides).colorGuide(options.filter),
             guides.normal, guides.albedo, options.filter);
       }
       result.rawWeights = argminOneHot(diagonal.maps, valid);
@@ -348,13 +378,20 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
         ++result.noisyFallbackPixels;
         for (int c = 0; c < 3; ++c) {
           blends.full(x, y, c) = guides.color(x, y, c);
-          blends.a(x, y, c) = guides.colorA(x, y, c);
-          blends.b(x, y, c) = guides.colorB(x, y, c);
+          if (blends.heldOut.empty()) {
+            blends.a(x, y, c) = guides.colorA(x, y, c);
+            blends.b(x, y, c) = guides.colorB(x, y, c);
+          }
+          const size_t e = (size_t(y) * size_t(w) + size_t(x)) * 3 + size_t(c);
+          for (size_t k = 0; k < blends.heldOut.size(); ++k)
+            blends.heldOut[k].data()[e] = quarterMeanWithout(guides, k, e);
         }
       }
   }
   result.image = std::move(blends.full);
-  result.mseEstimate = estimatedBlendMse(blends.a, blends.b, guides.colorA, guides.colorB);
+  result.mseEstimate = blends.heldOut.empty()
+                           ? estimatedBlendMse(blends.a, blends.b, guides.colorA, guides.colorB)
+                           : heldOutBlendMse(blends.heldOut, guides.quarters);
   result.imageA = std::move(blends.a);
   result.imageB = std::move(blends.b);
   clock.stop("blend");

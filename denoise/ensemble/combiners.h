@@ -55,11 +55,11 @@ struct StageTime {
 
 struct CombineResult {
   Image image;                    // the blend of the full-buffer outputs (RGB)
-  Image imageA, imageB;           // the same weights applied to the half-buffer outputs
+  Image imageA, imageB;           // the same weights applied to the half runs (empty without)
   std::vector<Image> weights;     // final weights, one map per base: 3 channels (per-channel
                                   // form) or 1 (summed form)
   std::vector<Image> rawWeights;  // the weights before the weight filter
-  Image mseEstimate;              // estimatedBlendMse of the result (RGB)
+  Image mseEstimate;              // estimatedBlendMse or heldOutBlendMse of the result (RGB)
   Image noisyFallback;            // 1 where the ensemble's result is the noisy value
                                   // (MseOptions::noisyFallback), else 0 (1 channel)
   size_t noisyFallbackPixels = 0;

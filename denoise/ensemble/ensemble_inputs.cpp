@@ -41,8 +41,14 @@ void checkEnsembleInputs(const EnsembleGuides& guides, std::span<const BaseOutpu
   for (const BaseOutputs* base : bases) {
     if (!names.insert(base->name).second)
       throw Error("base denoiser '" + base->name + "' is listed twice");
-    checkImage(base->a, "the output of " + base->name + " on half A", like);
-    checkImage(base->b, "the output of " + base->name + " on half B", like);
+    if (base->hasHalfRuns() != bases[0]->hasHalfRuns())
+      throw Error("base denoiser '" + base->name + "' " +
+                  (base->hasHalfRuns() ? "has" : "lacks") + " half runs, '" + bases[0]->name +
+                  "' " + (base->hasHalfRuns() ? "lacks them" : "has them"));
+    if (base->hasHalfRuns() || base->heldOut.empty()) {
+      checkImage(base->a, "the output of " + base->name + " on half A", like);
+      checkImage(base->b, "the output of " + base->name + " on half B", like);
+    }
     checkImage(base->full, "the output of " + base->name + " on the full buffer", like);
     if (base->heldOut.size() != bases[0]->heldOut.size() ||
         (!base->heldOut.empty() && base->heldOut.size() != 4))

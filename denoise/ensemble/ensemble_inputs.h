@@ -27,16 +27,21 @@ struct EnsembleGuides {
 
 // One base denoiser's outputs: y^A (run on half A only), y^B (half B only) and y (full buffer),
 // and, for the leave-one-quarter-out estimate, y^(−k): run on every quarter but k (k = 0 … 3;
-// denoise/pipeline/held_out_inputs.h). heldOut is empty when that estimate is not used.
+// denoise/pipeline/held_out_inputs.h). heldOut is empty when that estimate is not used; a and b
+// are empty when the held-out runs replace them (then every base has four held-out runs and
+// none has half runs).
 struct BaseOutputs {
   std::string name;
   Image a, b, full;
   std::vector<Image> heldOut;
+
+  bool hasHalfRuns() const { return !a.empty() || !b.empty(); }
 };
 
 // Throws chorus::Error (one line naming the image) unless every guide and base output is RGB
 // of the guides' size, and there are 1 … kMaxDenoisers bases with distinct names. Quarters and
-// held-out runs are optional, but when given, four of each (the held-out runs of every base).
+// held-out runs are optional, but when given, four of each (the held-out runs of every base);
+// half runs may be left out only when held-out runs are given, and by every base.
 void checkEnsembleInputs(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases);
 
 // Pointers to every element, for combine().

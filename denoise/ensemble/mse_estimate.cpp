@@ -120,8 +120,13 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
   if (!(options.memberFallback == 0 || options.memberFallback >= 1) ||
       !std::isfinite(options.memberFallback))
     throw Error("the member fallback's factor must be 0 (off) or a finite number ≥ 1");
-  // Inputs without quarters (K = 2, an outputs directory) use the halves.
-  const bool quarters = options.estimate != MseEstimate::Halves && !reference &&
+  // Inputs without quarters (K = 2, an outputs directory) use the halves; bases without half
+  // runs (the pipeline leaves them out for the quarters estimate) can only use the quarters.
+  const bool halfRuns = bases[0]->hasHalfRuns();
+  if (!halfRuns && !reference && options.estimate != MseEstimate::Quarters)
+    throw Error(std::string("the ") + estimateName(options.estimate) +
+                " estimate needs the members' half runs");
+  const bool quarters = (options.estimate != MseEstimate::Halves || !halfRuns) && !reference &&
                         guides.quarters.size() == 4 && bases[0]->heldOut.size() == 4;
   width_ = guides.width();
   height_ = guides.height();
@@ -130,7 +135,7 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
   std::vector<Fold> halves(2), heldOut;
   halves[0].comparator = guides.colorB.data();
   halves[1].comparator = guides.colorA.data();
-  for (int i = 0; i < baseCount_; ++i) {
+  for (int i = 0; i < baseCount_ && halfRuns; ++i) {
     halves[0].out[size_t(i)] = bases[size_t(i)]->a.data();
     halves[1].out[size_t(i)] = bases[size_t(i)]->b.data();
   }

@@ -68,12 +68,11 @@ Image gaussianBlur(const Image& image, int radius, float sigma) {
   return out;
 }
 
-}  // namespace
-
-ColorGuide makeColorGuide(const Image& blend, const Image& blendA, const Image& blendB,
-                          const WeightFilterOptions& options) {
-  if (!blend.sameShape(blendA) || !blend.sameShape(blendB))
-    throw Error("makeColorGuide: the blends differ in shape");
+// The guide from z and a per-element estimate of a half blend's variance, halfVariance(e)
+// (in z's units; divided by s² here).
+template <typename HalfVariance>
+ColorGuide colorGuide(const Image& blend, const HalfVariance& halfVarianceAt,
+                      const WeightFilterOptions& options) {
   double sum = 0;
   size_t count = 0;
   for (float v : blend.values())
@@ -89,14 +88,46 @@ ColorGuide makeColorGuide(const Image& blend, const Image& blendA, const Image& 
     for (size_t e = p0 * size_t(channels); e < p1 * size_t(channels); ++e) {
       const double z = blend.data()[e] / scale;
       guide.color.data()[e] = std::isfinite(z) ? float(std::clamp(z, -1e6, 1e6)) : 0.0f;
-      const double d = (double(blendA.data()[e]) - blendB.data()[e]) / scale;
-      const double v = 0.5 * d * d;
+      const double v = halfVarianceAt(e) / scale / scale;
       halfVariance.data()[e] = std::isfinite(v) ? float(std::min(v, 1e12)) : 1e12f;
     }
   });
   guide.variance =
       gaussianBlur(halfVariance, options.varianceBlurRadius, options.varianceBlurSigma);
   return guide;
+}
+
+}  // namespace
+
+ColorGuide makeColorGuide(const Image& blend, const Image& blendA, const Image& blendB,
+                          const WeightFilterOptions& options) {
+  if (!blend.sameShape(blendA) || !blend.sameShape(blendB))
+    throw Error("makeColorGuide: the blends differ in shape");
+  return colorGuide(
+      blend,
+      [&](size_t e) {
+        const double d = double(blendA.data()[e]) - blendB.data()[e];
+        return 0.5 * d * d;
+      },
+      options);
+}
+
+ColorGuide makeColorGuide(const Image& blend, std::span<const Image> heldOutBlends,
+                          const WeightFilterOptions& options) {
+  if (heldOutBlends.size() != 4) throw Error("makeColorGuide: expected four held-out blends");
+  for (const Image& image : heldOutBlends)
+    if (!blend.sameShape(image)) throw Error("makeColorGuide: the blends differ in shape");
+  return colorGuide(
+      blend,
+      [&](size_t e) {
+        // z^(−k) − z̄ = (x̄ − x_k)/3 for a linear blend: Σ_k (z^(−k) − z̄)² estimates 3/9 of a
+        // quarter's variance, i.e. 2/3 of a half's.
+        double mean = 0, sum = 0;
+        for (const Image& z : heldOutBlends) mean += 0.25 * z.data()[e];
+        for (const Image& z : heldOutBlends) sum += (z.data()[e] - mean) * (z.data()[e] - mean);
+        return 1.5 * sum;
+      },
+      options);
 }
 
 std::vector<Image> crossBilateralFilter(std::span<const Image> maps, const ColorGuide& guide,

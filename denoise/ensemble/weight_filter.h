@@ -1,8 +1,8 @@
 #pragma once
 // Smoothing of the per-pixel ensemble weights (Zheng et al. 2021, §4.3): a joint
 // (cross-)bilateral filter guided by the normal, the albedo and the blended colour with its
-// A/B variance, then renormalisation onto the simplex. Values follow the reference code
-// (radius 7, spatial σ 3, colour σ 2 on the variance-normalised distance, normal/albedo terms).
+// A/B variance (or the held-out blends' spread), then renormalisation onto the simplex. Values
+// follow the reference code (radius 7, spatial σ 3, colour σ 2 on the variance-normalised distance, normal/albedo terms).
 //
 // For a pixel p and neighbour q (|q − p|∞ ≤ radius, inside the image):
 //   k(p,q) = exp(− |p−q|²/(2σ_s²)
@@ -39,6 +39,11 @@ struct ColorGuide {
   Image variance;  // RGB
 };
 ColorGuide makeColorGuide(const Image& blend, const Image& blendA, const Image& blendB,
+                          const WeightFilterOptions& options);
+// The same without half runs: V from the four leave-one-quarter-out blends z^(−k),
+// 1.5 Σ_k (z^(−k) − z̄)², which has the expectation of ½(z^A − z^B)² for a linear blend (the
+// folds differ by a third of a quarter's noise each).
+ColorGuide makeColorGuide(const Image& blend, std::span<const Image> heldOutBlends,
                           const WeightFilterOptions& options);
 
 // Filters every channel of every map with the same kernel k(p,q) (maps: same size, any number

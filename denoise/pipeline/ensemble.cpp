@@ -100,20 +100,35 @@ bool readsHalves(std::span<const EnsembleMember> members) {
   return false;
 }
 
-bool usesHeldOutRuns(const MseOptions& options, const EnsembleSources& sources) {
-  return options.estimate != MseEstimate::Halves && hasQuarters(sources);
+BaseRuns baseRunsFor(const MseOptions& options, const EnsembleSources& sources) {
+  BaseRuns runs;
+  runs.heldOut = options.estimate != MseEstimate::Halves && hasQuarters(sources);
+  runs.halves = !runs.heldOut || options.estimate == MseEstimate::Extrapolated;
+  return runs;
 }
 
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
-                                          std::vector<StageTime>* times, bool heldOut) {
+                                          std::vector<StageTime>* times, BaseRuns runs) {
   checkMembersCanRun(sources, members);
   const Stopwatch all;
   const std::vector<DenoiseInput> heldOutInputList =
-      heldOut ? heldOutInputs(sources) : std::vector<DenoiseInput>{};
-  std::vector<const DenoiseInput*> inputs = {&sources.a, &sources.b, &sources.full};
-  for (const DenoiseInput& input : heldOutInputList) inputs.push_back(&input);
-  const size_t parts = inputs.size();
+      runs.heldOut ? heldOutInputs(sources) : std::vector<DenoiseInput>{};
+  // Every run: its input, its name in `times` and where its output goes.
+  struct Run {
+    const DenoiseInput* input;
+    std::string part;
+    Image BaseOutputs::*single;
+    size_t heldOut;
+  };
+  std::vector<Run> plan = {{&sources.full, "full", &BaseOutputs::full, 0}};
+  if (runs.halves) {
+    plan.push_back({&sources.a, "A", &BaseOutputs::a, 0});
+    plan.push_back({&sources.b, "B", &BaseOutputs::b, 0});
+  }
+  for (size_t k = 0; k < heldOutInputList.size(); ++k)
+    plan.push_back({&heldOutInputList[k], "without-q" + std::to_string(k), nullptr, k});
+  const size_t parts = plan.size();
   std::vector<BaseOutputs> outputs(members.size());
   std::vector<double> seconds(members.size() * parts);
   tbb::task_group group;
@@ -122,27 +137,20 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
     o.name = members[m].label;
     o.heldOut.resize(heldOutInputList.size());
     for (size_t part = 0; part < parts; ++part) {
-      Image* target = part == 0   ? &o.a
-                      : part == 1 ? &o.b
-                      : part == 2 ? &o.full
-                                  : &o.heldOut[part - 3];
+      const Run& run = plan[part];
+      Image* target = run.single ? &(o.*run.single) : &o.heldOut[run.heldOut];
       group.run([&, m, part, target] {
-        const Stopwatch run;
-        *target = members[m].denoiser->run(*inputs[part]);
-        seconds[m * parts + part] = run.seconds();
+        const Stopwatch clock;
+        *target = members[m].denoiser->run(*plan[part].input);
+        seconds[m * parts + part] = clock.seconds();
       });
     }
   }
   group.wait();
   if (times) {
     for (size_t m = 0; m < members.size(); ++m)
-      for (size_t part = 0; part < parts; ++part) {
-        const std::string partName = part == 0   ? "A"
-                                     : part == 1 ? "B"
-                                     : part == 2 ? "full"
-                                                 : "without-q" + std::to_string(part - 3);
-        times->push_back({members[m].label + "/" + partName, seconds[m * parts + part]});
-      }
+      for (size_t part = 0; part < parts; ++part)
+        times->push_back({members[m].label + "/" + plan[part].part, seconds[m * parts + part]});
     times->push_back({"bases", all.seconds()});
   }
   return outputs;
@@ -162,9 +170,9 @@ EnsembleResult Ensemble::run(const SampleBuffers& buffers, const Image* referenc
 
 EnsembleResult Ensemble::run(const EnsembleSources& sources, const Image* reference) const {
   EnsembleResult result;
-  const bool heldOut = usesHeldOutRuns(options_.mse, sources);
-  result.bases = runBaseDenoisers(sources, members_, &result.times, heldOut);
-  result.guides = guidesFromSources(sources, heldOut);
+  const BaseRuns runs = baseRunsFor(options_.mse, sources);
+  result.bases = runBaseDenoisers(sources, members_, &result.times, runs);
+  result.guides = guidesFromSources(sources, runs.heldOut);
   result.combined = combine(result.guides, pointersTo(result.bases), options_, reference);
   result.times.insert(result.times.end(), result.combined.times.begin(),
                       result.combined.times.end());

@@ -1,7 +1,7 @@
 #pragma once
-// The ensemble runner: runs the chosen base denoisers on half A, half B and the full buffer, and
-// for the leave-one-quarter-out estimate on the four held-out inputs (all 3N or 7N runs in
-// parallel as TBB tasks), then combines their outputs (combiners.h) and reports the
+// The ensemble runner: runs the chosen base denoisers on the full buffer and on half A and
+// half B, or for the leave-one-quarter-out estimate on the four held-out inputs instead (all
+// 3N or 5N runs in parallel as TBB tasks), then combines their outputs (combiners.h) and reports the
 // time of every stage. For sweeps that reuse base outputs across combinations, call
 // runBaseDenoisers() once and combine() per combination instead. runMembersAlone() runs members
 // on one input only, without the ensemble (`chorus denoise --combine none`).
@@ -52,23 +52,26 @@ std::vector<Image> runMembersAlone(const DenoiseInput& input,
                                    std::span<const EnsembleMember> members,
                                    std::vector<StageTime>* times = nullptr);
 
-// Whether the ensemble's estimate uses held-out runs: the options ask for the quarters (or the
-// extrapolated) estimate and the sources carry four independent quarters (K = 4). Otherwise it
-// uses the halves.
-bool usesHeldOutRuns(const MseOptions& options, const EnsembleSources& sources);
-
-// Every member on sources.a, .b and .full, and with `heldOut` also on the four inputs without
-// one quarter (held_out_inputs.h), in parallel. Appends "<label>/A", "<label>/B",
-// "<label>/full", "<label>/without-q<k>" (the time of each run) and "bases" (wall time of all
-// of them) to `times`.
+// Which runs of every member the ensemble needs besides the full buffer.
+struct BaseRuns {
+  bool halves = true;    // on half A and half B
+  bool heldOut = false;  // on the four inputs without one quarter (held_out_inputs.h)
+};
+// The runs an estimate needs on these sources: the quarters (and the extrapolated) estimate
+// use the held-out runs when the sources carry four independent quarters (K = 4), and then the
+// half runs are left out (the quarters estimate and the weight filter's guide need only the
+// held-out runs; the extrapolated estimate also needs the halves). Otherwise the half runs.
+BaseRuns baseRunsFor(const MseOptions& options, const EnsembleSources& sources);
+// Every member on sources.full and on the runs that `runs` asks for, in parallel. Appends
+// "<label>/A", "<label>/B", "<label>/full", "<label>/without-q<k>" (the time of each run) and
+// "bases" (wall time of all of them) to `times`.
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
                                           std::vector<StageTime>* times = nullptr,
-                                          bool heldOut = false);
-
+                                          BaseRuns runs = {});
 struct EnsembleResult {
   CombineResult combined;          // image, weights, A/B blends, estimated MSE
-  std::vector<BaseOutputs> bases;  // every base output (A, B, full), in member order
+  std::vector<BaseOutputs> bases;  // every base output (full, A/B or held out), in member order
   EnsembleGuides guides;           // the noisy inputs the weights were estimated from
   std::vector<StageTime> times;    // every stage: base runs, "bases", "solve", "filter", "blend"
 };

@@ -168,9 +168,9 @@ MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& spec
   } catch (const Error& e) {
     throw fileError(input.path, e.what() + inputHint(input, false));
   }
-  const bool heldOut = usesHeldOutRuns(mse, sources);
-  runs.bases = runBaseDenoisers(sources, members, &runs.times, heldOut);
-  *guides = guidesFromSources(sources, heldOut);
+  const BaseRuns needed = baseRunsFor(mse, sources);
+  runs.bases = runBaseDenoisers(sources, members, &runs.times, needed);
+  *guides = guidesFromSources(sources, needed.heldOut);
   return runs;
 }
 

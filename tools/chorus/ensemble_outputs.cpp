@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <iostream>
+#include <vector>
 
 #include "common/error.h"
 #include "common/image/exr_io.h"
@@ -66,6 +67,7 @@ nlohmann::ordered_json combineOptionsJson(const CombineOptions& o) {
 std::vector<ExrLayer> writeRepairedExr(const std::filesystem::path& path,
                                        std::vector<ExrLayer> layers,
                                        const std::function<bool(const std::string&)>& isSigned) {
+  std::erase_if(layers, [](const ExrLayer& layer) { return layer.image.empty(); });
   OutputRepairs repairs;
   for (ExrLayer& layer : layers) {
     const OutputRepairs r = repairForOutput(layer.image, isSigned && isSigned(layer.name));

@@ -32,12 +32,13 @@ nlohmann::ordered_json combineOptionsJson(const CombineOptions& options);
 
 // Writes the layers after repairForOutput (common/image/output_values.h: no NaN/Inf, and no
 // negative radiance except in the layers `isSigned` names), with one warning line on stderr
-// counting what was replaced. Returns the layers as written.
+// counting what was replaced. Empty layers are left out. Returns the layers as written.
 std::vector<ExrLayer> writeRepairedExr(
     const std::filesystem::path& path, std::vector<ExrLayer> layers,
     const std::function<bool(const std::string&)>& isSigned = {});
 
-// DIR/<name>.exr (layers: RGB = the blend, A, B, mseEstimate) and DIR/<name>.png, through
+// DIR/<name>.exr (layers: RGB = the blend, A and B when the members ran on the halves,
+// mseEstimate) and DIR/<name>.png, through
 // writeRepairedExr.
 void writeCombined(const std::filesystem::path& dir, const std::string& name,
                    const CombineResult& result);
@@ -47,7 +48,7 @@ void writeCombined(const std::filesystem::path& dir, const std::string& name,
 void writeWeights(const std::filesystem::path& dir, const std::string& file,
                   const CombineResult& result, const std::vector<BaseOutputs>& bases);
 
-// DIR/<base>.exr for every base: RGB = the full-buffer output, layers A and B.
+// DIR/<base>.exr for every base: RGB = the full-buffer output, layers A and B (when run).
 void writeBaseOutputs(const std::filesystem::path& dir, const std::vector<BaseOutputs>& bases);
 
 }  // namespace chorus::cli

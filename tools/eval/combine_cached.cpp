@@ -38,7 +38,7 @@ struct Args {
   std::string cache, name, out, methods, combos, combiners = "ensemble";
   std::string previewMethods, previewSpp = "4", spp;
   int threads = 2;
-  bool fullFromHeldOut = false, diagnose = false;
+  bool fullFromHeldOut = false, diagnose = false, noHalfRuns = false;
   cli::EnsembleFlags ensemble;
 };
 
@@ -54,6 +54,7 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
   for (const std::string& m : methods) {
     BaseOutputs& o = outputs[m] = readCachedMember(caseDir, m);
     alone[m] = o.full;
+    if (args.noHalfRuns && o.heldOut.size() == 4) o.a = o.b = Image();
     if (args.fullFromHeldOut && o.heldOut.size() == 4)
       for (size_t e = 0; e < o.full.size(); ++e) {
         float sum = 0;
@@ -168,6 +169,9 @@ int main(int argc, char** argv) {
                "Print each member's relMSE on A, B, full and held-out runs instead");
   app.add_flag("--full-from-held-out", args.fullFromHeldOut,
                "Replace each member's full-buffer output by the mean of its four held-out runs");
+  app.add_flag("--no-half-runs", args.noHalfRuns,
+               "Drop the members' half runs where held-out runs replace them (as the pipeline "
+               "does for the quarters estimate)");
   args.ensemble.addFlags(app);
   return chorus::eval::parseAndRun(app, argc, argv, "combine_cached", [&] { run(args); });
 }

@@ -96,7 +96,7 @@ void run(const Args& args) {
     if (!fs::exists(cachedMemberPath(dir, spec))) pending.push_back({spec, memberDenoiser(spec)});
   if (!pending.empty()) {
     std::vector<StageTime> times;
-    const std::vector<BaseOutputs> outputs = runBaseDenoisers(sources, pending, &times, true);
+    const std::vector<BaseOutputs> outputs = runBaseDenoisers(sources, pending, &times, {true, true});
     for (const BaseOutputs& o : outputs) {
       std::vector<double> seconds;
       for (const StageTime& t : times)

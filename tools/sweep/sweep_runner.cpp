@@ -195,9 +195,9 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
   const EnsembleSources sources = sourcesFromBuffers(render.buffers);
   checkMembersCanRun(sources, plan.members);
   std::vector<StageTime> times;
-  const bool heldOut = usesHeldOutRuns(config.combine.mse, sources);
-  const std::vector<BaseOutputs> bases = runBaseDenoisers(sources, plan.members, &times, heldOut);
-  const EnsembleGuides guides = guidesFromSources(sources, heldOut);
+  const BaseRuns runs = baseRunsFor(config.combine.mse, sources);
+  const std::vector<BaseOutputs> bases = runBaseDenoisers(sources, plan.members, &times, runs);
+  const EnsembleGuides guides = guidesFromSources(sources, runs.heldOut);
 
   // Times. A base denoiser alone costs one run on the full buffer (what a user running only it
   // pays). A combination costs its members' runs on A, B, full (and the held-out inputs) plus the

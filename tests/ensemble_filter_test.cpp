@@ -270,8 +270,8 @@ TEST(WeightFilter, HeldOutGuideHasTheExpectationOfTheHalvesGuide) {
   std::vector<Image> shrunk = heldOut;
   for (size_t k = 0; k < 4; ++k)
     for (size_t e = 0; e < full.size(); ++e)
-      shrunk[k].data()[e] = full.data()[e] + std::sqrt(2.0f / 3.0f) *
-                                                 (heldOut[k].data()[e] - full.data()[e]);
+      shrunk[k].data()[e] =
+          full.data()[e] + std::sqrt(2.0f / 3.0f) * (heldOut[k].data()[e] - full.data()[e]);
   EXPECT_LT(meanVariance(makeColorGuide(full, shrunk, {})), 0.8 * expected);
 }
 

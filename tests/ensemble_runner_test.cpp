@@ -1,6 +1,7 @@
 // The Ensemble runner: runs every member on the full buffer and on half A and half B or the four
-// held-out inputs (exactly what running the denoiser on those inputs gives), combines, reports every stage's
-// time, refuses members that cannot run on the given sub-buffers, and is deterministic.
+// held-out inputs (exactly what running the denoiser on those inputs gives), combines, reports
+// every stage's time, refuses members that cannot run on the given sub-buffers, and is
+// deterministic.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -100,8 +101,7 @@ TEST(EnsembleRunner, RunsEveryMemberOnHalfAHalfBAndFull) {
   // The guides are the noisy halves, and the combination is combine() on those outputs.
   EXPECT_TRUE(sameImage(result.guides.colorA, b.part(BufferPart::HalfA).color.mean));
   EXPECT_TRUE(sameImage(result.guides.colorB, b.part(BufferPart::HalfB).color.mean));
-  const CombineResult direct =
-      combine(result.guides, pointersTo(result.bases), ensemble.options());
+  const CombineResult direct = combine(result.guides, pointersTo(result.bases), ensemble.options());
   EXPECT_TRUE(sameImage(result.combined.image, direct.image));
   EXPECT_TRUE(result.bases[0].heldOut.empty());
   // Every stage is timed.
@@ -129,15 +129,16 @@ TEST(EnsembleRunner, TheQuartersEstimateRunsTheHeldOutInputsInsteadOfTheHalves) 
   EXPECT_TRUE(result.combined.mseEstimate.sameShape(result.combined.image));
   const std::set<std::string> stages = stagesOf(result);
   EXPECT_EQ(stages.count("box1/A") + stages.count("box3/B"), 0u);
-  for (const char* stage : {"box1/full", "box1/without-q0", "box3/without-q3", "bases", "solve",
-                            "filter", "blend"})
+  for (const char* stage :
+       {"box1/full", "box1/without-q0", "box3/without-q3", "bases", "solve", "filter", "blend"})
     EXPECT_TRUE(stages.count(stage)) << stage;
   // Combining the same runs with the halves estimate is refused in one line.
-  EXPECT_THROW(combine(result.guides, pointersTo(result.bases),
-                       withEstimate(MseEstimate::Extrapolated)),
-               Error);
+  EXPECT_THROW(
+      combine(result.guides, pointersTo(result.bases), withEstimate(MseEstimate::Extrapolated)),
+      Error);
 
-  const EnsembleResult both = Ensemble(boxMembers(), withEstimate(MseEstimate::Extrapolated)).run(b);
+  const EnsembleResult both =
+      Ensemble(boxMembers(), withEstimate(MseEstimate::Extrapolated)).run(b);
   EXPECT_TRUE(both.bases[0].hasHalfRuns());
   EXPECT_EQ(both.bases[0].heldOut.size(), 4u);
   EXPECT_FALSE(both.combined.imageA.empty());

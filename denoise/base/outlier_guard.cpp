@@ -124,9 +124,12 @@ class PartGuard {
     double amount;
   };
 
-  // Adds amount × k(q) / Σ k to every pixel q of the (2 spreadRadius + 1)² window inside the
-  // image, the outlier's own included, with the Gaussian k(q) = exp(−|q − p|² / (2 (r/2)²)): the
-  // window keeps the outlier's energy, without the edges a box would draw.
+  // Adds amount × g(q) s(q) / Σ g to every pixel q of the (2 spreadRadius + 1)² window inside
+  // the image, the outlier's own included, with the Gaussian g(q) = exp(−|q − p|² / (2 (r/2)²))
+  // and s(q) = sameSurface: on one surface the window keeps the outlier's energy, without the
+  // edges a box would draw. The share that falls on other surfaces is dropped, not given to the
+  // outlier's surface: on a thin one (a lamp's arm, a few pixels wide) that concentrated an
+  // excess of the whole window onto a handful of pixels (0.96 where the reference is 0.004).
   void spread(const Excess& e, MeanVariance& out, std::vector<uint8_t>& changed) const {
     const int w = part_.width(), h = part_.height(), r = o_.spreadRadius;
     const int x0 = std::max(0, e.x - r), x1 = std::min(w - 1, e.x + r);
@@ -135,18 +138,19 @@ class PartGuard {
     const Image& depth = part_.depth.mean;
     const bool hasDepth = depth.sameSize(part_.color.mean);
     const double here = hasDepth ? depth(e.x, e.y, 0) : 0.0;
-    auto kernel = [&](int x, int y) {
+    auto gaussian = [&](int x, int y) {
       const double dx = x - e.x, dy = y - e.y;
-      return std::exp(-(dx * dx + dy * dy) * falloff) *
-             (hasDepth ? sameSurface(here, depth(x, y, 0)) : 1.0);
+      return std::exp(-(dx * dx + dy * dy) * falloff);
     };
     double total = 0;
     for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) total += kernel(x, y);
+      for (int x = x0; x <= x1; ++x) total += gaussian(x, y);
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
+        const double share =
+            gaussian(x, y) * (hasDepth ? sameSurface(here, depth(x, y, 0)) : 1.0) / total;
         float& m = out.mean(x, y, e.c);
-        m = float(std::min(double(m) + e.amount * kernel(x, y) / total, double(kMaxFloat)));
+        m = float(std::min(double(m) + e.amount * share, double(kMaxFloat)));
         changed[size_t(y) * size_t(w) + size_t(x)] = 1;
       }
   }

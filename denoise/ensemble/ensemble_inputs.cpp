@@ -42,9 +42,9 @@ void checkEnsembleInputs(const EnsembleGuides& guides, std::span<const BaseOutpu
     if (!names.insert(base->name).second)
       throw Error("base denoiser '" + base->name + "' is listed twice");
     if (base->hasHalfRuns() != bases[0]->hasHalfRuns())
-      throw Error("base denoiser '" + base->name + "' " +
-                  (base->hasHalfRuns() ? "has" : "lacks") + " half runs, '" + bases[0]->name +
-                  "' " + (base->hasHalfRuns() ? "lacks them" : "has them"));
+      throw Error("base denoiser '" + base->name + "' " + (base->hasHalfRuns() ? "has" : "lacks") +
+                  " half runs, '" + bases[0]->name + "' " +
+                  (base->hasHalfRuns() ? "lacks them" : "has them"));
     if (base->hasHalfRuns() || base->heldOut.empty()) {
       checkImage(base->a, "the output of " + base->name + " on half A", like);
       checkImage(base->b, "the output of " + base->name + " on half B", like);

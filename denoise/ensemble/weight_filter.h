@@ -2,7 +2,8 @@
 // Smoothing of the per-pixel ensemble weights (Zheng et al. 2021, §4.3): a joint
 // (cross-)bilateral filter guided by the normal, the albedo and the blended colour with its
 // A/B variance (or the held-out blends' spread), then renormalisation onto the simplex. Values
-// follow the reference code (radius 7, spatial σ 3, colour σ 2 on the variance-normalised distance, normal/albedo terms).
+// follow the reference code (radius 7, spatial σ 3, colour σ 2 on the variance-normalised distance,
+// normal/albedo terms).
 //
 // For a pixel p and neighbour q (|q − p|∞ ≤ radius, inside the image):
 //   k(p,q) = exp(− |p−q|²/(2σ_s²)

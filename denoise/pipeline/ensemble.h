@@ -1,8 +1,8 @@
 #pragma once
 // The ensemble runner: runs the chosen base denoisers on the full buffer and on half A and
 // half B, or for the leave-one-quarter-out estimate on the four held-out inputs instead (all
-// 3N or 5N runs in parallel as TBB tasks), then combines their outputs (combiners.h) and reports the
-// time of every stage. For sweeps that reuse base outputs across combinations, call
+// 3N or 5N runs in parallel as TBB tasks), then combines their outputs (combiners.h) and reports
+// the time of every stage. For sweeps that reuse base outputs across combinations, call
 // runBaseDenoisers() once and combine() per combination instead. runMembersAlone() runs members
 // on one input only, without the ensemble (`chorus denoise --combine none`).
 #include <memory>

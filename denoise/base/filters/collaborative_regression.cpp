@@ -88,6 +88,10 @@ struct Group {
   int r, d, channels;        // window radius, design columns, data channels
   const float* weights;      // w_δ(first centre) = weights[offsetIndex(δ) · weightStride]
   size_t weightStride;       // floats between the weight planes of consecutive offsets
+  int power;                 // the regression's weights are those of the table to this power
+  bool floorCentre;          // with power > 1: the centre weight keeps the floor centreFloor
+  float centreFloor;         // (CenterWeight::Computed) in the lanes inside the image,
+  int insideLanes;           // the first insideLanes
   const BorderedPlanes* fu;  // features (m planes) then data (C planes), zero border ≥ r + kLanes
 };
 
@@ -104,6 +108,23 @@ struct Group {
 
 [[gnu::always_inline]] inline void centreFeatures(const Group& g, int d, Lanes* fp) {
   for (int j = 0; j < d - 3; ++j) fp[j] = loadLanes(g.fu->row(j, g.y) + g.x0);
+}
+
+// exp(−41): fast_exp gives 0 below about this.
+constexpr float kSmallestWeight = 1.6e-18f;
+
+// The weights w of offset (dx, dy) raised to the group's power: w^p is the weight of the
+// bandwidth k / √p, whose distances are p times larger (up to ε and the distance clamp, which
+// only decide where weights are 0 anyway). Like computed weights, they are 0 where exp would
+// underflow, and the centre weight keeps the floor of CenterWeight::Computed.
+[[gnu::always_inline]] inline Lanes toPower(const Group& g, Lanes w, int dx, int dy) {
+  Lanes p = w;
+  for (int e = 1; e < g.power; ++e) p *= w;
+  p = p < splat(kSmallestWeight) ? Lanes{} : p;
+  if (dx == 0 && dy == 0 && g.floorCentre)
+    for (int lane = 0; lane < g.insideLanes; ++lane)
+      p[lane] = p[lane] < g.centreFloor ? g.centreFloor : p[lane];
+  return p;
 }
 
 inline const float* offsetWeights(const Group& g, int dx, int dy) {
@@ -237,7 +258,8 @@ template <int kD, int kC>
       // Each offset's weights are in another plane of the table, a cache line no hardware
       // prefetcher predicts: ask for the next window row's while this one is summed.
       if (dy < g.r) __builtin_prefetch(offsetWeights(g, dx, dy + 1));
-      const Lanes w = loadLanes(offsetWeights(g, dx, dy));
+      Lanes w = loadLanes(offsetWeights(g, dx, dy));
+      if (g.power > 1) w = toPower(g, w, dx, dy);
       storeLanes(groupWeights, w);
       // Every lane +0 (weights are never negative): the bits OR-ed.
       uint64_t bits[kLanes / 2];
@@ -329,8 +351,7 @@ struct TileResult {
 
 struct ThreadState {
   NlMeansScratch scratch;
-  std::vector<float> table;    // weights [offset][tile pixel], tile rows kTileSize wide
-  std::vector<float> powered;  // the table's weights raised to a power
+  std::vector<float> table;  // weights [offset][tile pixel], tile rows kTileSize wide
   GroupSums sums;
   WindowRowScratch windowRow;
   std::vector<float> groupWeights;  // w_δ of one group, offset after offset
@@ -376,7 +397,7 @@ class Regression {
       ThreadState& st = states.local();
       fillWeightTable(tiles[t], st);
       for (size_t i = 0; i < powers_.size(); ++i)
-        regressTile(tiles[t], st, weightsToPower(tiles[t], st, powers_[i]), results[i][t]);
+        regressTile(tiles[t], st, powers_[i], results[i][t]);
     });
     std::vector<Image> out;
     for (const auto& r : results) out.push_back(gather(tiles, r));
@@ -406,33 +427,8 @@ class Regression {
     });
   }
 
-  // The table's weights raised to `power` (the table itself for 1): w^p is the weight of the
-  // bandwidth k / √p, whose distances are p times larger (up to ε and the distance clamp, which
-  // only decide where weights are 0 anyway). Like computed weights, they are 0 where exp would
-  // underflow, and the centre weight keeps the floor of CenterWeight::Computed.
-  const float* weightsToPower(const PixelRect& tile, ThreadState& st, int power) const {
-    if (power == 1) return st.table.data();
-    st.powered.resize(st.table.size());
-    const float* src = st.table.data();
-    float* dst = st.powered.data();
-    for (size_t i = 0; i < st.table.size(); ++i) {
-      float w = src[i];
-      for (int e = 1; e < power; ++e) w *= src[i];
-      dst[i] = w < kSmallestWeight ? 0.0f : w;
-    }
-    if (weights_.params().center == CenterWeight::Computed) {
-      float* center = dst + size_t(offsetIndex(0, 0)) * planeStride();
-      for (int y = 0; y < tile.height(); ++y)
-        for (int x = 0; x < std::min(kTileSize, width_ - tile.x0); ++x) {
-          float& w = center[y * kTileSize + x];
-          w = std::max(w, weights_.params().minCenterWeight);
-        }
-    }
-    return dst;
-  }
-
-  void regressTile(const PixelRect& tile, ThreadState& st, const float* table,
-                   TileResult& out) const {
+  // The regression with the table's weights to `power` (accumulateSums raises them).
+  void regressTile(const PixelRect& tile, ThreadState& st, int power, TileResult& out) const {
     out.extent = tile.grown(r_);
     const size_t accWidth = size_t(out.extent.width()), accPlane = size_t(out.extent.area());
     out.acc.assign(accPlane * size_t(channels_ + 1), 0.0f);
@@ -441,14 +437,19 @@ class Regression {
     st.windowRow.columns.resize(2 * size_t(side_));
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x0 = tile.x0; x0 < std::min(tile.x1, width_); x0 += kLanes) {
-        const Group g{.x0 = x0,
-                      .y = y,
-                      .r = r_,
-                      .d = d_,
-                      .channels = channels_,
-                      .weights = table + size_t(y - tile.y0) * kTileSize + size_t(x0 - tile.x0),
-                      .weightStride = planeStride(),
-                      .fu = &fu_};
+        const Group g{
+            .x0 = x0,
+            .y = y,
+            .r = r_,
+            .d = d_,
+            .channels = channels_,
+            .weights = st.table.data() + size_t(y - tile.y0) * kTileSize + size_t(x0 - tile.x0),
+            .weightStride = planeStride(),
+            .power = power,
+            .floorCentre = weights_.params().center == CenterWeight::Computed,
+            .centreFloor = weights_.params().minCenterWeight,
+            .insideLanes = std::min(kLanes, width_ - x0),
+            .fu = &fu_};
         accumulateSums(g, st.sums, st.groupWeights.data(), st.skip.data(), st.windowRow);
         Lanes beta[kMaxGramSize * kMaxGramRhs];
         solveLanes(st.sums, std::min(kLanes, width_ - x0), beta);
@@ -508,9 +509,6 @@ class Regression {
     });
     return result;
   }
-
-  // exp(−41): fast_exp gives 0 below about this.
-  static constexpr float kSmallestWeight = 1.6e-18f;
 
   const NlMeansWeights& weights_;
   std::vector<int> powers_;

@@ -88,22 +88,21 @@ struct Group {
   int r, d, channels;        // window radius, design columns, data channels
   const float* weights;      // w_δ(first centre) = weights[offsetIndex(δ) · weightStride]
   size_t weightStride;       // floats between the weight planes of consecutive offsets
-  int power;                 // the regression's weights are those of the table to this power
-  bool floorCentre;          // with power > 1: the centre weight keeps the floor centreFloor
-  float centreFloor;         // (CenterWeight::Computed) in the lanes inside the image,
-  int insideLanes;           // the first insideLanes
+  int power;                 // the regression's weights: the table's to this power (toPower)
+  bool floorCentre;          // raised centre weights keep at least centreFloor
+  float centreFloor;         // (CenterWeight::Computed) where the centre is inside the image:
+  int insideLanes;           // in the first insideLanes lanes
   const BorderedPlanes* fu;  // features (m planes) then data (C planes), zero border ≥ r + kLanes
 };
 
-// The design-matrix row of window offset δ = (dx, dy) for the kLanes centres, then the data:
-// x = [1, dx, dy, f_j(q) − f_j(p) …, u_c(q) …] with q = p + δ (d design columns, C data).
-[[gnu::always_inline]] inline void designRow(const Group& g, int d, int C, const Lanes* fp, int dx,
-                                             int dy, Lanes* x) {
+// The design-matrix row of window offset δ = (dx, dy) for the kLanes centres:
+// x = [1, dx, dy, f_j(q) − f_j(p) …] with q = p + δ (d columns).
+[[gnu::always_inline]] inline void designRow(const Group& g, int d, const Lanes* fp, int dx, int dy,
+                                             Lanes* x) {
   x[0] = splat(1.0f);
   x[1] = splat(float(dx));
   x[2] = splat(float(dy));
   for (int j = 0; j < d - 3; ++j) x[3 + j] = loadLanes(g.fu->row(j, g.y + dy) + g.x0 + dx) - fp[j];
-  for (int c = 0; c < C; ++c) x[d + c] = loadLanes(g.fu->row(d - 3 + c, g.y + dy) + g.x0 + dx);
 }
 
 [[gnu::always_inline]] inline void centreFeatures(const Group& g, int d, Lanes* fp) {
@@ -319,7 +318,7 @@ template <int kD, int kC>
       const Lanes w = loadLanes(groupWeights);
       groupWeights += kLanes;
       if (*skip++) continue;
-      designRow(g, d, 0, fp, dx, dy, x);
+      designRow(g, d, fp, dx, dy, x);
       float* at = acc + accAt + ptrdiff_t(dy) * ptrdiff_t(accWidth) + dx;
       for (int c = 0; c < C; ++c) {
         Lanes p = beta[c];

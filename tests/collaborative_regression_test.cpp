@@ -243,15 +243,24 @@ Image bruteForceRegression(const Image& image, const Image& features, const NlMe
   return out;
 }
 
-TEST(CollaborativeRegression, MatchesPerWindowPivotedQr) {
+void expectMatchesPerWindowPivotedQr(int features) {
   // Non-affine random data: the fits are genuine least-squares problems.
-  Scene s = affineScene(21, 19, 3, 40);
+  Scene s = affineScene(21, 19, features, 40);
   s.image = test::randomImage(21, 19, 3, 41, 0.0f, 2.0f);
   const int r = 3;
   const NlMeansWeights weights = regressionWeights(s, r, 0.7f);
   const Image out = collaborativeRegression(s.image, s.features, weights);
   const Image want = bruteForceRegression(s.image, s.features, weights, s, r);
   expectRelativeNear(out, want, 2e-4);
+}
+
+TEST(CollaborativeRegression, MatchesPerWindowPivotedQr) {
+  expectMatchesPerWindowPivotedQr(3);
+}
+
+// NFOR's shape (8 features, RGB) runs a kernel of its own (fixed sizes, sums in register blocks).
+TEST(CollaborativeRegression, MatchesPerWindowPivotedQrInNforsShape) {
+  expectMatchesPerWindowPivotedQr(8);
 }
 
 }  // namespace

@@ -215,19 +215,21 @@ TEST(OutputValues, RepairsAndCounts) {
 
 TEST(LocalRange, MatchesBruteForce) {
   Image image = test::randomImage(13, 9, 2, 7, -1.0f, 1.0f);
-  image(4, 4, 1) = kNan;  // skipped
-  const LocalRange range = localRange(image, 2);
-  for (int y = 0; y < 9; ++y)
-    for (int x = 0; x < 13; ++x)
-      for (int c = 0; c < 2; ++c) {
-        float lo = kInf, hi = -kInf;
-        for (int qy = std::max(0, y - 2); qy <= std::min(8, y + 2); ++qy)
-          for (int qx = std::max(0, x - 2); qx <= std::min(12, x + 2); ++qx)
-            if (std::isfinite(image(qx, qy, c)))
-              lo = std::min(lo, image(qx, qy, c)), hi = std::max(hi, image(qx, qy, c));
-        ASSERT_EQ(range.lo(x, y, c), lo);
-        ASSERT_EQ(range.hi(x, y, c), hi);
-      }
+  image(4, 4, 1) = kNan;       // skipped
+  for (int radius : {2, 9}) {  // 9: windows wider than the image is tall
+    const LocalRange range = localRange(image, radius);
+    for (int y = 0; y < 9; ++y)
+      for (int x = 0; x < 13; ++x)
+        for (int c = 0; c < 2; ++c) {
+          float lo = kInf, hi = -kInf;
+          for (int qy = std::max(0, y - radius); qy <= std::min(8, y + radius); ++qy)
+            for (int qx = std::max(0, x - radius); qx <= std::min(12, x + radius); ++qx)
+              if (std::isfinite(image(qx, qy, c)))
+                lo = std::min(lo, image(qx, qy, c)), hi = std::max(hi, image(qx, qy, c));
+          ASSERT_EQ(range.lo(x, y, c), lo) << radius;
+          ASSERT_EQ(range.hi(x, y, c), hi) << radius;
+        }
+  }
 }
 
 }  // namespace

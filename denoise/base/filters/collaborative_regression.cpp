@@ -9,6 +9,7 @@
 #include <cstring>
 #include <span>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "denoise/base/filters/bordered_planes.h"
@@ -36,16 +37,6 @@ constexpr int kTileSize = 32;  // tile side; tiles are always kTileSize wide (se
 constexpr int kLanes = 16;
 static_assert(kTileSize % kLanes == 0);
 using Lanes = float __attribute__((vector_size(kLanes * sizeof(float))));
-// The Gram sums are formed in double: on near-collinear columns (a smooth surface's normals
-// are almost linear in dx, dy) the part of a column the others do not explain is far below
-// float rounding of the sums, and a float Gram either loses it or (with a coarse pivot
-// tolerance) has to drop the column — which Tungsten's QR on √W X keeps. The products of
-// float inputs w · x_a are exact in double.
-using SumLanes = double __attribute__((vector_size(kLanes * sizeof(double))));
-[[gnu::always_inline]] inline SumLanes wide(Lanes v) {
-  return __builtin_convertvector(v, SumLanes);
-}
-
 [[gnu::always_inline]] inline Lanes loadLanes(const float* p) {
   Lanes v;
   std::memcpy(&v, p, sizeof v);
@@ -60,16 +51,29 @@ using SumLanes = double __attribute__((vector_size(kLanes * sizeof(double))));
   return Lanes{} + v;
 }
 
-// Whether every lane is +0 (weights are never negative): the bits OR-folded in halves.
-[[gnu::always_inline]] inline bool allZero(Lanes v) {
-  using Bits16 = uint32_t __attribute__((vector_size(16 * sizeof(uint32_t))));
-  static_assert(sizeof(Bits16) == sizeof(Lanes));
-  const Bits16 b16 = (Bits16)v;  // the same bits (a vector conversion between equal sizes)
-  const auto b8 = __builtin_shufflevector(b16, b16, 0, 1, 2, 3, 4, 5, 6, 7) |
-                  __builtin_shufflevector(b16, b16, 8, 9, 10, 11, 12, 13, 14, 15);
-  const auto b4 =
-      __builtin_shufflevector(b8, b8, 0, 1, 2, 3) | __builtin_shufflevector(b8, b8, 4, 5, 6, 7);
-  return ((b4[0] | b4[1]) | (b4[2] | b4[3])) == 0;
+// The Gram sums are formed in double: on near-collinear columns (a smooth surface's normals
+// are almost linear in dx, dy) the part of a column the others do not explain is far below
+// float rounding of the sums, and a float Gram either loses it or (with a coarse pivot
+// tolerance) has to drop the column — which Tungsten's QR on √W X keeps. The products of
+// float inputs w · x_a are exact in double. They run over half a group's lanes at a time (one
+// AVX-512 register per sum), so that a block of them stays in registers over a window row.
+constexpr int kHalf = kLanes / 2;
+using HalfSums = double __attribute__((vector_size(kHalf * sizeof(double))));
+using SumLanes = double __attribute__((vector_size(kLanes * sizeof(double))));
+[[gnu::always_inline]] inline SumLanes wide(Lanes v) {
+  return __builtin_convertvector(v, SumLanes);
+}
+
+// Memory outside the kernels' own stack frames holds plain doubles: code built for the baseline
+// aligns these vector types to less than the AVX-512 clones assume.
+[[gnu::always_inline]] inline HalfSums loadSums(const double* p) {
+  HalfSums v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+[[gnu::always_inline]] inline void storeSums(double* p, HalfSums v) {
+  std::memcpy(p, &v, sizeof v);
 }
 
 // Columns of the design matrix and of the data: d ≤ kMaxGramSize, C ≤ kMaxGramRhs.
@@ -84,26 +88,43 @@ struct Group {
   int r, d, channels;        // window radius, design columns, data channels
   const float* weights;      // w_δ(first centre) = weights[offsetIndex(δ) · weightStride]
   size_t weightStride;       // floats between the weight planes of consecutive offsets
+  int power;                 // the regression's weights: the table's to this power (toPower)
+  bool floorCentre;          // raised centre weights keep at least centreFloor
+  float centreFloor;         // (CenterWeight::Computed) where the centre is inside the image:
+  int insideLanes;           // in the first insideLanes lanes
   const BorderedPlanes* fu;  // features (m planes) then data (C planes), zero border ≥ r + kLanes
 };
 
-// The design-matrix row of window offset δ = (dx, dy) for the kLanes centres, then the data:
-// x = [1, dx, dy, f_j(q) − f_j(p) …, u_c(q) …] with q = p + δ (d design columns, C data).
-[[gnu::always_inline]] inline void designRow(const Group& g, int d, int C, const Lanes* fp, int dx,
-                                             int dy, Lanes* x) {
+// The design-matrix row of window offset δ = (dx, dy) for the kLanes centres:
+// x = [1, dx, dy, f_j(q) − f_j(p) …] with q = p + δ (d columns).
+[[gnu::always_inline]] inline void designRow(const Group& g, int d, const Lanes* fp, int dx, int dy,
+                                             Lanes* x) {
   x[0] = splat(1.0f);
   x[1] = splat(float(dx));
   x[2] = splat(float(dy));
   for (int j = 0; j < d - 3; ++j) x[3 + j] = loadLanes(g.fu->row(j, g.y + dy) + g.x0 + dx) - fp[j];
-  for (int c = 0; c < C; ++c) x[d + c] = loadLanes(g.fu->row(d - 3 + c, g.y + dy) + g.x0 + dx);
 }
 
 [[gnu::always_inline]] inline void centreFeatures(const Group& g, int d, Lanes* fp) {
   for (int j = 0; j < d - 3; ++j) fp[j] = loadLanes(g.fu->row(j, g.y) + g.x0);
 }
 
-// How many offsets ahead accumulateSums prefetches the weights.
-constexpr int kPrefetchOffsets = 4;
+// exp(−41): fast_exp gives 0 below about this.
+constexpr float kSmallestWeight = 1.6e-18f;
+
+// The weights w of offset (dx, dy) raised to the group's power: w^p is the weight of the
+// bandwidth k / √p, whose distances are p times larger (up to ε and the distance clamp, which
+// only decide where weights are 0 anyway). Like computed weights, they are 0 where exp would
+// underflow, and the centre weight keeps the floor of CenterWeight::Computed.
+[[gnu::always_inline]] inline Lanes toPower(const Group& g, Lanes w, int dx, int dy) {
+  Lanes p = w;
+  for (int e = 1; e < g.power; ++e) p *= w;
+  p = p < splat(kSmallestWeight) ? Lanes{} : p;
+  if (dx == 0 && dy == 0 && g.floorCentre)
+    for (int lane = 0; lane < g.insideLanes; ++lane)
+      p[lane] = p[lane] < g.centreFloor ? g.centreFloor : p[lane];
+  return p;
+}
 
 inline const float* offsetWeights(const Group& g, int dx, int dy) {
   const int side = 2 * g.r + 1;
@@ -120,74 +141,164 @@ constexpr int sumIndex(int total, int a, int b) {
   return a * total - a * (a - 1) / 2 + (b - a);
 }
 
+// The values of one window offset for half a group's lanes, in double: the weights and the
+// columns x_a of the design row and the data (x_2 = dy is not stored: see accumulateSumsOf).
+struct OffsetColumns {
+  double w[kHalf];
+  double x[kMaxColumns][kHalf];
+};
+
+// The design rows a ≠ 2 of the Gram sums in blocks of two: {0, 1}, {3, 4}, {5, 6}, …
+constexpr int rowBlocks(int d) {
+  return d / 2;
+}
+
+[[gnu::always_inline]] inline void addTo(double* sum, HalfSums v) {
+  storeSums(sum, loadSums(sum) + v);
+}
+
+// The window row dy's part of the sums (a, b) with a in block k: the row's sum
+// Σ_dx w · x_a · x_b over its `live` offsets (in order) for every b ≥ a, b ≠ 2 — a block of
+// accumulators that stays in registers over the row, instead of every sum loaded and stored
+// at every offset — is added to sums[sumIndex(a, b)]. Block 0 also adds the sums with the dy
+// column (a or b = 2): dy times the row's sums with column 0.
+template <int kD, int kC>
+[[gnu::always_inline]] inline void rowBlockSums(int d, int total, int k, const OffsetColumns* cols,
+                                                int live, int dy, double (*sums)[kHalf]) {
+  const int a0 = k == 0 ? 0 : 2 * k + 1, a1 = k == 0 ? 1 : 2 * k + 2;
+  const int rows = a1 < d ? 2 : 1;
+  const int rowOf[2] = {a0, a1};
+  HalfSums acc[2][kMaxColumns];
+#pragma GCC unroll 2
+  for (int r = 0; r < rows; ++r)
+#pragma GCC unroll 32
+    for (int b = a0; b < total; ++b) acc[r][b] = HalfSums{};
+  for (int i = 0; i < live; ++i) {
+    const OffsetColumns& o = cols[i];
+    HalfSums wa[2] = {};
+#pragma GCC unroll 2
+    for (int r = 0; r < rows; ++r) wa[r] = loadSums(o.w) * loadSums(o.x[rowOf[r]]);
+#pragma GCC unroll 32
+    for (int b = a0; b < total; ++b) {
+      if (b == 2) continue;
+      const HalfSums xb = loadSums(o.x[b]);
+#pragma GCC unroll 2
+      for (int r = 0; r < rows; ++r)
+        if (b >= rowOf[r]) acc[r][b] += wa[r] * xb;
+    }
+  }
+#pragma GCC unroll 2
+  for (int r = 0; r < rows; ++r)
+#pragma GCC unroll 32
+    for (int b = rowOf[r]; b < total; ++b)
+      if (b != 2) addTo(sums[sumIndex(total, rowOf[r], b)], acc[r][b]);
+  if (k == 0) {
+    const HalfSums rowDy = HalfSums{} + double(dy), withDy = rowDy * acc[0][0];
+    addTo(sums[sumIndex(total, 0, 2)], withDy);
+    addTo(sums[sumIndex(total, 1, 2)], rowDy * acc[0][1]);
+    addTo(sums[sumIndex(total, 2, 2)], rowDy * withDy);
+#pragma GCC unroll 32
+    for (int b = 3; b < total; ++b) addTo(sums[sumIndex(total, 2, b)], rowDy * acc[0][b]);
+  }
+}
+
+template <int kD, int kC, int... kBlock>
+[[gnu::always_inline]] inline void allRowBlockSums(std::integer_sequence<int, kBlock...>,
+                                                   const OffsetColumns* cols, int live, int dy,
+                                                   double (*sums)[kHalf]) {
+  (rowBlockSums<kD, kC>(kD, kD + kC, kBlock, cols, live, dy, sums), ...);
+}
+
+// The Gram sums of a group, in double: half[h][e] holds sum e (see kMaxSums) of the lanes
+// h · kHalf … h · kHalf + kHalf − 1.
+struct GroupSums {
+  double half[2][kMaxSums][kHalf];
+};
+
+// Scratch of accumulateSums: the columns of a window row's live offsets (2r + 1 per half of
+// the lanes).
+struct WindowRowScratch {
+  std::vector<OffsetColumns> columns;
+};
+
+// Stores the lanes of v as the two halves' columns.
+[[gnu::always_inline]] inline void storeHalves(double* lo, double* hi, SumLanes v) {
+  storeSums(lo, __builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7));
+  storeSums(hi, __builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15));
+}
+
 // A weight of exactly 0 adds exactly 0 (the values it multiplies are finite), so offsets where
 // every centre of the group has one are skipped — neighbours across a strong edge, outside the
 // image. accumulateSums marks them (skip[offsetIndex(δ)]) for accumulatePredictions.
 //
-// sums (see kMaxSums) = Σ_δ w_δ · x_a · x_b for every centre of the group, in double. Each
-// window row is summed on its own first and then added (two-level summation). Column 2
-// is dy, constant along a window row, so its sums are dy times the row's sums with column 0
-// (Σ w dy x_b = dy Σ w x_b), formed once per row instead of at every offset. The weights are
-// also copied to `groupWeights` (w_δ at offsetIndex(δ) · kLanes) for the predictions: the
-// table's planes are far apart, and this way it is read only once.
+// sums = Σ_δ w_δ · x_a · x_b for every centre of the group, in double. Each window row is
+// summed on its own first and then added (two-level summation). Column 2 is dy, constant along
+// a window row, so its sums are dy times the row's sums with column 0 (Σ w dy x_b = dy Σ w x_b),
+// formed once per row instead of at every offset. The weights are also copied to
+// `groupWeights` (w_δ at offsetIndex(δ) · kLanes) for the predictions: the table's planes are
+// far apart, and this way it is read only once.
 template <int kD, int kC>
-[[gnu::always_inline]] inline void accumulateSumsOf(const Group& g, SumLanes* sums,
-                                                    float* groupWeights, uint8_t* skip) {
+[[gnu::always_inline]] inline void accumulateSumsOf(const Group& g, GroupSums& sums,
+                                                    float* groupWeights, uint8_t* skip,
+                                                    WindowRowScratch& scratch) {
   const int d = kD ? kD : g.d, C = kD ? kC : g.channels, total = d + C;
-  const int count = d * (d + 1) / 2 + d * C;
-  Lanes fp[kMaxGramSize], x[kMaxColumns];
-  SumLanes xd[kMaxColumns], rowSums[kMaxSums];
+  const int count = d * (d + 1) / 2 + d * C, side = 2 * g.r + 1;
+  Lanes fp[kMaxGramSize];
   centreFeatures(g, d, fp);
-  for (int e = 0; e < count; ++e) sums[e] = SumLanes{};
+  for (int h = 0; h < 2; ++h)
+    for (int e = 0; e < count; ++e) storeSums(sums.half[h][e], HalfSums{});
+  OffsetColumns* cols[2] = {scratch.columns.data(), scratch.columns.data() + side};
   for (int dy = -g.r; dy <= g.r; ++dy) {
-    for (int e = 0; e < count; ++e) rowSums[e] = SumLanes{};
+    // Where the columns ≥ 3 of offset (0, dy) are (features, then data).
+    const float* planes[kMaxColumns];
+    for (int a = 3; a < total; ++a) planes[a] = g.fu->row(a - 3, g.y + dy) + g.x0;
+    int live = 0;
     for (int dx = -g.r; dx <= g.r; ++dx) {
       // Each offset's weights are in another plane of the table, a cache line no hardware
-      // prefetcher predicts: ask for the one a few offsets ahead.
-      __builtin_prefetch(offsetWeights(g, dx, dy) + kPrefetchOffsets * g.weightStride);
-      const Lanes w = loadLanes(offsetWeights(g, dx, dy));
+      // prefetcher predicts: ask for the next window row's while this one is summed.
+      if (dy < g.r) __builtin_prefetch(offsetWeights(g, dx, dy + 1));
+      Lanes w = loadLanes(offsetWeights(g, dx, dy));
+      if (g.power > 1) w = toPower(g, w, dx, dy);
       storeLanes(groupWeights, w);
+      // Every lane +0 (weights are never negative): the bits OR-ed.
+      uint64_t bits[kLanes / 2];
+      std::memcpy(bits, groupWeights, sizeof bits);
       groupWeights += kLanes;
-      *skip = allZero(w);
+      *skip = ((bits[0] | bits[1]) | (bits[2] | bits[3]) | (bits[4] | bits[5]) |
+               (bits[6] | bits[7])) == 0;
       if (*skip++) continue;
-      designRow(g, d, C, fp, dx, dy, x);
-      const SumLanes wd = wide(w);
-      if constexpr (kD > 0) {
+      OffsetColumns &lo = cols[0][live], &hi = cols[1][live];
+      ++live;
+      storeHalves(lo.w, hi.w, wide(w));
+      storeSums(lo.x[0], HalfSums{} + 1.0);
+      storeSums(hi.x[0], HalfSums{} + 1.0);
+      storeSums(lo.x[1], HalfSums{} + double(float(dx)));
+      storeSums(hi.x[1], HalfSums{} + double(float(dx)));
 #pragma GCC unroll 32
-        for (int a = 0; a < kD + kC; ++a) xd[a] = wide(x[a]);
-#pragma GCC unroll 32
-        for (int a = 0; a < kD; ++a) {
-          if (a == 2) continue;
-          const SumLanes wa = wd * xd[a];
-#pragma GCC unroll 32
-          for (int b = a; b < kD + kC; ++b)
-            if (b != 2) rowSums[sumIndex(kD + kC, a, b)] += wa * xd[b];
-        }
-      } else {
-        for (int a = 0; a < total; ++a) xd[a] = wide(x[a]);
-        for (int a = 0; a < d; ++a) {
-          if (a == 2) continue;
-          const SumLanes wa = wd * xd[a];
-          for (int b = a; b < total; ++b)
-            if (b != 2) rowSums[sumIndex(total, a, b)] += wa * xd[b];
-        }
-      }
+      for (int j = 0; j < d - 3; ++j)
+        storeHalves(lo.x[3 + j], hi.x[3 + j], wide(loadLanes(planes[3 + j] + dx) - fp[j]));
+#pragma GCC unroll 8
+      for (int c = 0; c < C; ++c)
+        storeHalves(lo.x[d + c], hi.x[d + c], wide(loadLanes(planes[d + c] + dx)));
     }
-    const SumLanes rowDy = SumLanes{} + double(dy);
-    rowSums[sumIndex(total, 0, 2)] = rowDy * rowSums[sumIndex(total, 0, 0)];
-    rowSums[sumIndex(total, 1, 2)] = rowDy * rowSums[sumIndex(total, 0, 1)];
-    for (int b = 2; b < total; ++b)
-      rowSums[sumIndex(total, 2, b)] = rowDy * rowSums[sumIndex(total, 0, b)];
-    for (int e = 0; e < count; ++e) sums[e] += rowSums[e];
+    if (live == 0) continue;  // the row would add 0 to every sum
+    for (int h = 0; h < 2; ++h) {
+      if constexpr (kD > 0)
+        allRowBlockSums<kD, kC>(std::make_integer_sequence<int, rowBlocks(kD)>{}, cols[h], live, dy,
+                                sums.half[h]);
+      else
+        for (int k = 0; k < rowBlocks(d); ++k)
+          rowBlockSums<kD, kC>(d, total, k, cols[h], live, dy, sums.half[h]);
+    }
   }
 }
 
-CHORUS_SIMD_CLONES void accumulateSums(const Group& g, SumLanes* sums, float* groupWeights,
-                                       uint8_t* skip) {
+CHORUS_SIMD_CLONES void accumulateSums(const Group& g, GroupSums& sums, float* groupWeights,
+                                       uint8_t* skip, WindowRowScratch& scratch) {
   if (g.d == kNforColumns && g.channels == kNforChannels)
-    accumulateSumsOf<kNforColumns, kNforChannels>(g, sums, groupWeights, skip);
+    accumulateSumsOf<kNforColumns, kNforChannels>(g, sums, groupWeights, skip, scratch);
   else
-    accumulateSumsOf<0, 0>(g, sums, groupWeights, skip);
+    accumulateSumsOf<0, 0>(g, sums, groupWeights, skip, scratch);
 }
 
 // acc_c(q) += w_δ(p) · x_qᵀ β_c(p) and wsum(q) += w_δ(p) for every q = p + δ of the group's
@@ -207,7 +318,7 @@ template <int kD, int kC>
       const Lanes w = loadLanes(groupWeights);
       groupWeights += kLanes;
       if (*skip++) continue;
-      designRow(g, d, 0, fp, dx, dy, x);
+      designRow(g, d, fp, dx, dy, x);
       float* at = acc + accAt + ptrdiff_t(dy) * ptrdiff_t(accWidth) + dx;
       for (int c = 0; c < C; ++c) {
         Lanes p = beta[c];
@@ -239,9 +350,9 @@ struct TileResult {
 
 struct ThreadState {
   NlMeansScratch scratch;
-  std::vector<float> table;    // weights [offset][tile pixel], tile rows kTileSize wide
-  std::vector<float> powered;  // the table's weights raised to a power
-  SumLanes sums[kMaxSums];
+  std::vector<float> table;  // weights [offset][tile pixel], tile rows kTileSize wide
+  GroupSums sums;
+  WindowRowScratch windowRow;
   std::vector<float> groupWeights;  // w_δ of one group, offset after offset
   std::vector<uint8_t> skip;        // per offset: every weight of the group is 0
 };
@@ -285,7 +396,7 @@ class Regression {
       ThreadState& st = states.local();
       fillWeightTable(tiles[t], st);
       for (size_t i = 0; i < powers_.size(); ++i)
-        regressTile(tiles[t], st, weightsToPower(tiles[t], st, powers_[i]), results[i][t]);
+        regressTile(tiles[t], st, powers_[i], results[i][t]);
     });
     std::vector<Image> out;
     for (const auto& r : results) out.push_back(gather(tiles, r));
@@ -315,49 +426,30 @@ class Regression {
     });
   }
 
-  // The table's weights raised to `power` (the table itself for 1): w^p is the weight of the
-  // bandwidth k / √p, whose distances are p times larger (up to ε and the distance clamp, which
-  // only decide where weights are 0 anyway). Like computed weights, they are 0 where exp would
-  // underflow, and the centre weight keeps the floor of CenterWeight::Computed.
-  const float* weightsToPower(const PixelRect& tile, ThreadState& st, int power) const {
-    if (power == 1) return st.table.data();
-    st.powered.resize(st.table.size());
-    const float* src = st.table.data();
-    float* dst = st.powered.data();
-    for (size_t i = 0; i < st.table.size(); ++i) {
-      float w = src[i];
-      for (int e = 1; e < power; ++e) w *= src[i];
-      dst[i] = w < kSmallestWeight ? 0.0f : w;
-    }
-    if (weights_.params().center == CenterWeight::Computed) {
-      float* center = dst + size_t(offsetIndex(0, 0)) * planeStride();
-      for (int y = 0; y < tile.height(); ++y)
-        for (int x = 0; x < std::min(kTileSize, width_ - tile.x0); ++x) {
-          float& w = center[y * kTileSize + x];
-          w = std::max(w, weights_.params().minCenterWeight);
-        }
-    }
-    return dst;
-  }
-
-  void regressTile(const PixelRect& tile, ThreadState& st, const float* table,
-                   TileResult& out) const {
+  // The regression with the table's weights to `power` (accumulateSums raises them).
+  void regressTile(const PixelRect& tile, ThreadState& st, int power, TileResult& out) const {
     out.extent = tile.grown(r_);
     const size_t accWidth = size_t(out.extent.width()), accPlane = size_t(out.extent.area());
     out.acc.assign(accPlane * size_t(channels_ + 1), 0.0f);
     st.groupWeights.resize(size_t(side_ * side_) * kLanes);
     st.skip.resize(size_t(side_ * side_));
+    st.windowRow.columns.resize(2 * size_t(side_));
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x0 = tile.x0; x0 < std::min(tile.x1, width_); x0 += kLanes) {
-        const Group g{.x0 = x0,
-                      .y = y,
-                      .r = r_,
-                      .d = d_,
-                      .channels = channels_,
-                      .weights = table + size_t(y - tile.y0) * kTileSize + size_t(x0 - tile.x0),
-                      .weightStride = planeStride(),
-                      .fu = &fu_};
-        accumulateSums(g, st.sums, st.groupWeights.data(), st.skip.data());
+        const Group g{
+            .x0 = x0,
+            .y = y,
+            .r = r_,
+            .d = d_,
+            .channels = channels_,
+            .weights = st.table.data() + size_t(y - tile.y0) * kTileSize + size_t(x0 - tile.x0),
+            .weightStride = planeStride(),
+            .power = power,
+            .floorCentre = weights_.params().center == CenterWeight::Computed,
+            .centreFloor = weights_.params().minCenterWeight,
+            .insideLanes = std::min(kLanes, width_ - x0),
+            .fu = &fu_};
+        accumulateSums(g, st.sums, st.groupWeights.data(), st.skip.data(), st.windowRow);
         Lanes beta[kMaxGramSize * kMaxGramRhs];
         solveLanes(st.sums, std::min(kLanes, width_ - x0), beta);
         const size_t at = size_t(y - out.extent.y0) * accWidth + size_t(x0 - out.extent.x0);
@@ -367,14 +459,15 @@ class Regression {
   }
 
   // β of every live lane from its sums (rank-revealing, in double); β = 0 for the others.
-  void solveLanes(const SumLanes* sums, int live, Lanes* beta) const {
+  void solveLanes(const GroupSums& sums, int live, Lanes* beta) const {
     for (int e = 0; e < d_ * channels_; ++e) beta[e] = Lanes{};
     for (int lane = 0; lane < live; ++lane) {
       double gram[kMaxGramSize * kMaxGramSize], rhs[kMaxGramSize * kMaxGramRhs];
-      const SumLanes* s = sums;
+      const double(*s)[kHalf] = sums.half[lane / kHalf];
+      const int at = lane % kHalf;
       for (int a = 0; a < d_; ++a) {
-        for (int b = a; b < d_; ++b) gram[a * d_ + b] = (*s++)[lane];
-        for (int c = 0; c < channels_; ++c) rhs[a * channels_ + c] = (*s++)[lane];
+        for (int b = a; b < d_; ++b) gram[a * d_ + b] = (*s++)[at];
+        for (int c = 0; c < channels_; ++c) rhs[a * channels_ + c] = (*s++)[at];
       }
       double solution[kMaxGramSize * kMaxGramRhs];
       solveGramPivoted(gram, rhs, d_, channels_, solution, tol_);
@@ -415,9 +508,6 @@ class Regression {
     });
     return result;
   }
-
-  // exp(−41): fast_exp gives 0 below about this.
-  static constexpr float kSmallestWeight = 1.6e-18f;
 
   const NlMeansWeights& weights_;
   std::vector<int> powers_;

@@ -114,57 +114,76 @@ class NforRun {
  public:
   NforRun(const NforParams& p, const DenoiseInput& input) : p_(p), input_(input) {}
 
+  // Each stage is a function of its own, so that its intermediate images are freed (and their
+  // memory reused by the next stage) as soon as it ends: fewer pages first touched.
   Image run() {
-    const auto& halves = *input_.halves;
-    const Image c1 = clampedFinite(halves[0].color.mean), c2 = clampedFinite(halves[1].color.mean);
     const Image c = clampedFinite(input_.whole.color.mean);
-    const Image sigma2 = colorVariance(input_);
-
-    // Feature cross-prefiltering (§5.1): A's features with weights from B's, and vice versa.
-    const Image f1 = featureMeans(halves[0]), f2 = featureMeans(halves[1]);
-    const Image fVar = featureVariances(input_);
-    const NlMeansParams prefilterWindow = window(p_.prefilterR);
-    const Image f1Filtered =
-        nlMeans(f1, perChannelTerm(f2, fVar, p_.prefilterF, p_.prefilterK, 2.0f), prefilterWindow);
-    const Image f2Filtered =
-        nlMeans(f2, perChannelTerm(f1, fVar, p_.prefilterF, p_.prefilterK, 2.0f), prefilterWindow);
-
-    // Regression passes (§5.2): colour of one half, weights from the other half's colour,
-    // regressed on the other half's filtered features.
-    const std::array<Image, 2> y1 = regressBothBandwidths(c1, f2Filtered, c2, sigma2);
-    const std::array<Image, 2> y2 = regressBothBandwidths(c2, f1Filtered, c1, sigma2);
-    Image mse[2];
-    for (int i = 0; i < 2; ++i) mse[i] = mseEstimate(c1, c2, y1[i], y2[i], sigma2);
-
-    // Bandwidth selection (§5.3): smoothed MSE, per-channel binary map, smoothed map.
-    const NlMeansWeights smoothing(perChannelTerm(c, sigma2, p_.mseF, p_.mseK, 1.0f),
-                                   window(p_.mseR));
-    const Image* mses[] = {&mse[0], &mse[1]};
-    const NlMeansFilterResult smoothed = nlMeansFilterAll(mses, smoothing);
-    const Image noisySelection = combine(smoothed.filtered[0], smoothed.filtered[1],
-                                         [](float e1, float e2) { return e1 < e2 ? 0.0f : 1.0f; });
-    const Image selection = nlMeansFilter(noisySelection, smoothing);
-    const Image r1 = blend(y1[0], y1[1], selection), r2 = blend(y2[0], y2[1], selection);
-
-    // Second filter pass (§5.4) on the means of the halves, with their dual-buffer variances.
-    const Image fMean =
-        combine(f1Filtered, f2Filtered, [](float a, float b) { return (a + b) * 0.5f; });
-    const Image fMeanVar =
-        combine(f1Filtered, f2Filtered, [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
-    const Image fFinal =
-        nlMeans(fMean, perChannelTerm(fMean, fMeanVar, p_.finalFeatureF, p_.finalFeatureK, 1.0f),
-                window(p_.finalFeatureR));
-    const Image rMean = combine(r1, r2, [](float a, float b) { return (a + b) * 0.5f; });
-    const Image rMeanVar =
-        combine(r1, r2, [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
-    Image out = regress(rMean, fFinal, rMean, rMeanVar, p_.finalF, p_.finalK, p_.finalR);
-
+    const std::array<Image, 2> fFiltered = prefilteredFeatures();
+    const std::array<Image, 2> r = firstPass(c, fFiltered);
+    Image out = secondPass(fFiltered, r);
     for (size_t i = 0; i < out.size(); ++i)
       if (!std::isfinite(out.data()[i])) out.data()[i] = c.data()[i];
     return out;
   }
 
  private:
+  // Feature cross-prefiltering (§5.1): A's features with weights from B's, and vice versa.
+  std::array<Image, 2> prefilteredFeatures() const {
+    const auto& halves = *input_.halves;
+    const Image f1 = featureMeans(halves[0]), f2 = featureMeans(halves[1]);
+    const Image fVar = featureVariances(input_);
+    const NlMeansParams prefilterWindow = window(p_.prefilterR);
+    return {
+        nlMeans(f1, perChannelTerm(f2, fVar, p_.prefilterF, p_.prefilterK, 2.0f), prefilterWindow),
+        nlMeans(f2, perChannelTerm(f1, fVar, p_.prefilterF, p_.prefilterK, 2.0f), prefilterWindow)};
+  }
+
+  // The halves' first-pass outputs r1, r2: each half's two bandwidths blended by the selection.
+  std::array<Image, 2> firstPass(const Image& c, const std::array<Image, 2>& fFiltered) const {
+    const auto& halves = *input_.halves;
+    const Image c1 = clampedFinite(halves[0].color.mean), c2 = clampedFinite(halves[1].color.mean);
+    const Image sigma2 = colorVariance(input_);
+
+    // Regression passes (§5.2): colour of one half, weights from the other half's colour,
+    // regressed on the other half's filtered features.
+    const std::array<Image, 2> y1 = regressBothBandwidths(c1, fFiltered[1], c2, sigma2);
+    const std::array<Image, 2> y2 = regressBothBandwidths(c2, fFiltered[0], c1, sigma2);
+    const Image selection = selectionMap(c, c1, c2, sigma2, y1, y2);
+    return {blend(y1[0], y1[1], selection), blend(y2[0], y2[1], selection)};
+  }
+
+  // Bandwidth selection (§5.3): smoothed MSE, per-channel binary map, smoothed map.
+  Image selectionMap(const Image& c, const Image& c1, const Image& c2, const Image& sigma2,
+                     const std::array<Image, 2>& y1, const std::array<Image, 2>& y2) const {
+    Image mse[2];
+    for (int i = 0; i < 2; ++i) mse[i] = mseEstimate(c1, c2, y1[i], y2[i], sigma2);
+    const NlMeansWeights smoothing(perChannelTerm(c, sigma2, p_.mseF, p_.mseK, 1.0f),
+                                   window(p_.mseR));
+    const Image* mses[] = {&mse[0], &mse[1]};
+    const NlMeansFilterResult smoothed = nlMeansFilterAll(mses, smoothing);
+    const Image noisySelection = combine(smoothed.filtered[0], smoothed.filtered[1],
+                                         [](float e1, float e2) { return e1 < e2 ? 0.0f : 1.0f; });
+    return nlMeansFilter(noisySelection, smoothing);
+  }
+
+  // Second filter pass (§5.4) on the means of the halves, with their dual-buffer variances.
+  Image secondPass(const std::array<Image, 2>& fFiltered, const std::array<Image, 2>& r) const {
+    const Image fFinal = finalFeatures(fFiltered);
+    const Image rMean = combine(r[0], r[1], [](float a, float b) { return (a + b) * 0.5f; });
+    const Image rMeanVar =
+        combine(r[0], r[1], [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
+    return regress(rMean, fFinal, rMean, rMeanVar, p_.finalF, p_.finalK, p_.finalR);
+  }
+
+  Image finalFeatures(const std::array<Image, 2>& fFiltered) const {
+    const Image fMean =
+        combine(fFiltered[0], fFiltered[1], [](float a, float b) { return (a + b) * 0.5f; });
+    const Image fMeanVar = combine(fFiltered[0], fFiltered[1],
+                                   [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
+    return nlMeans(fMean, perChannelTerm(fMean, fMeanVar, p_.finalFeatureF, p_.finalFeatureK, 1.0f),
+                   window(p_.finalFeatureR));
+  }
+
   NlMeansParams window(int r) const {
     return {.r = r, .center = CenterWeight::Computed, .minCenterWeight = p_.minCenterWeight};
   }

@@ -7,9 +7,14 @@ the most that choosing among them per image could give.
 
     python3 tools/eval/compare_variants.py --cache build/eval-cache --half tuning base v1 v2
 
+A variant is a name under CACHE/variants/ or the path of a variant folder (to compare variants
+of two caches, e.g. before and after a member change). "vs FIRST" also gives the geometric
+mean of the ensemble's relMSE over the first variant's, case by case.
+
 Python 3 standard library only; exit code 2 on bad input.
 """
 import argparse
+import math
 import os
 import sys
 
@@ -44,7 +49,7 @@ def main(argv=None):
         corpus = corpus_file.load(args.corpus)
         tables = {}
         for v in args.variants:
-            folder = os.path.join(args.cache, "variants", v)
+            folder = v if os.path.isdir(v) else os.path.join(args.cache, "variants", v)
             if not os.path.isdir(folder):
                 raise corpus_file.CorpusError("%s: no such variant folder" % folder)
             tables[v] = cases_of(folder, corpus, args.half)
@@ -57,8 +62,10 @@ def main(argv=None):
         t = tables[v]
         wins = sum(t[k]["ensemble"] < 0.99 * first[k]["ensemble"] for k in keys)
         losses = sum(t[k]["ensemble"] > 1.01 * first[k]["ensemble"] for k in keys)
-        print(line(v, (t[k] for k in keys)) + "  vs %s: +%d -%d" % (args.variants[0], wins,
-                                                                     losses))
+        ratio = math.exp(sum(math.log(t[k]["ensemble"] / first[k]["ensemble"]) for k in keys
+                             if t[k]["ensemble"] > 0 and first[k]["ensemble"] > 0) / len(keys))
+        print(line(v, (t[k] for k in keys)) + "  vs %s: +%d -%d, geo %.4f" % (
+            args.variants[0], wins, losses, ratio))
     best_case = [min((tables[v][k] for v in args.variants), key=lambda c: c["ensemble"])
                  for k in keys]
     print(line("best variant per case", best_case))

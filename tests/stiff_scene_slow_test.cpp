@@ -1,10 +1,10 @@
 // The stiff rendered scene (scenes/stiff-caustics.gltf: a tiny emitter sealed in a glass ball,
 // so that everything it lights is found by rare caustic paths, samples thousands of times the
 // mean) at 64×64 and 4, 16 and 64 spp (K = 4), against a 4096-spp reference rendered here with
-// its own seed. Every registered member must beat the noisy input on the full buffer and
-// write finite, non-negative values on A, B and the full buffer; the ensemble of all of them
-// must stay within 1.1× of its best member at 16 and 64 spp and within 1.3× at 4 spp (measured
-// 1.23×: at 64×64 and 4 spp its estimate from the half buffers is the weak point, issue 25).
+// its own seed. Every registered member, run alone on the full buffer, must beat the noisy
+// input; every run (alone, and the held-out runs the ensemble blends) writes finite,
+// non-negative values; the ensemble of all of them must stay within 1.1× of its best member at
+// 16 and 64 spp and within 1.3× at 4 spp (measured on 2026-12-05: 0.92×, 0.99× and 1.07×).
 // docs/outliers.md has the figures at 128×128 against a 2048-spp reference.
 #include <gtest/gtest.h>
 
@@ -50,17 +50,24 @@ TEST(StiffScene, MembersBeatTheNoisyInputAndTheEnsembleTracksTheBest) {
   const Image reference = renderStiff(4096, 1, 1000).part(BufferPart::Full).color.mean;
   std::vector<std::string> names;
   for (const DenoiserEntry& entry : builtinDenoisers()) names.push_back(entry.name);
-  const Ensemble ensemble(membersFromSpecs(names), {});
+  const std::vector<EnsembleMember> members = membersFromSpecs(names);
+  const Ensemble ensemble(members, {});
   for (int spp : {4, 16, 64}) {
     const SampleBuffers buffers = renderStiff(spp, 4, uint64_t(spp));
     const double noisy = relMse(buffers.part(BufferPart::Full).color.mean, reference);
     const EnsembleResult result = ensemble.run(buffers);
+    // A member is what a user running it alone gets: its run on the full buffer (the ensemble
+    // blends the mean of its held-out runs instead).
+    const std::vector<Image> alone = runMembersAlone(buffers.input(BufferPart::Full), members);
     std::printf("%3d spp: noisy %.4g", spp, noisy);
     double best = std::numeric_limits<double>::infinity();
-    for (const BaseOutputs& base : result.bases) {
-      for (const Image* out : {&base.full, &base.a, &base.b})
+    for (size_t m = 0; m < members.size(); ++m) {
+      const BaseOutputs& base = result.bases[m];
+      for (const Image* out : {&alone[m], &base.full, &base.a, &base.b})
         EXPECT_TRUE(finiteNonNegative(*out)) << base.name << " at " << spp << " spp";
-      const double e = relMse(base.full, reference);
+      for (const Image& run : base.heldOut)
+        EXPECT_TRUE(finiteNonNegative(run)) << base.name << " at " << spp << " spp";
+      const double e = relMse(alone[m], reference);
       std::printf("  %s %.4g", base.name.c_str(), e);
       EXPECT_LT(e, noisy) << base.name << " at " << spp << " spp";
       best = std::min(best, e);

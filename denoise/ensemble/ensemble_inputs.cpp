@@ -62,6 +62,22 @@ void checkEnsembleInputs(const EnsembleGuides& guides, std::span<const BaseOutpu
   }
 }
 
+Image meanOfHeldOutRuns(const BaseOutputs& base) {
+  if (base.heldOut.size() != 4)
+    throw Error("base denoiser '" + base.name + "' has no four held-out runs to average");
+  Image mean = base.heldOut[0];
+  for (size_t k = 1; k < 4; ++k)
+    if (!base.heldOut[k].sameShape(mean))
+      throw Error("the held-out runs of '" + base.name + "' differ in shape");
+  // In double: four values near FLT_MAX have a finite mean but not a finite float sum.
+  for (size_t e = 0; e < mean.size(); ++e) {
+    double sum = 0;
+    for (const Image& run : base.heldOut) sum += run.data()[e];
+    mean.data()[e] = float(0.25 * sum);
+  }
+  return mean;
+}
+
 std::vector<const BaseOutputs*> pointersTo(const std::vector<BaseOutputs>& bases) {
   std::vector<const BaseOutputs*> pointers;
   for (const BaseOutputs& base : bases) pointers.push_back(&base);

@@ -44,6 +44,12 @@ struct BaseOutputs {
 // half runs may be left out only when held-out runs are given, and by every base.
 void checkEnsembleInputs(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases);
 
+// The mean of a base's four held-out runs: with the quarters estimate this is the base's output
+// that the ensemble blends instead of a run on the full buffer (it uses every sample; for a
+// linear filter it equals the full run, and for the nonlinear members it was better on the
+// corpus: docs/ensemble-quality.md). Requires four held-out runs.
+Image meanOfHeldOutRuns(const BaseOutputs& base);
+
 // Pointers to every element, for combine().
 std::vector<const BaseOutputs*> pointersTo(const std::vector<BaseOutputs>& bases);
 

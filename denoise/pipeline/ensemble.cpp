@@ -104,6 +104,7 @@ BaseRuns baseRunsFor(const MseOptions& options, const EnsembleSources& sources) 
   BaseRuns runs;
   runs.heldOut = options.estimate != MseEstimate::Halves && hasQuarters(sources);
   runs.halves = !runs.heldOut || options.estimate == MseEstimate::Extrapolated;
+  runs.full = runs.halves;
   return runs;
 }
 
@@ -121,7 +122,10 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
     Image BaseOutputs::*single;
     size_t heldOut;
   };
-  std::vector<Run> plan = {{&sources.full, "full", &BaseOutputs::full, 0}};
+  if (!runs.full && !runs.heldOut)
+    throw Error("runBaseDenoisers: without the full run the held-out runs are needed");
+  std::vector<Run> plan;
+  if (runs.full) plan.push_back({&sources.full, "full", &BaseOutputs::full, 0});
   if (runs.halves) {
     plan.push_back({&sources.a, "A", &BaseOutputs::a, 0});
     plan.push_back({&sources.b, "B", &BaseOutputs::b, 0});
@@ -147,6 +151,8 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
     }
   }
   group.wait();
+  if (!runs.full)
+    for (BaseOutputs& o : outputs) o.full = meanOfHeldOutRuns(o);
   if (times) {
     for (size_t m = 0; m < members.size(); ++m)
       for (size_t part = 0; part < parts; ++part)

@@ -1,7 +1,7 @@
 #pragma once
 // The ensemble runner: runs the chosen base denoisers on the full buffer and on half A and
 // half B, or for the leave-one-quarter-out estimate on the four held-out inputs instead (all
-// 3N or 5N runs in parallel as TBB tasks), then combines their outputs (combiners.h) and reports
+// 3N or 4N runs in parallel as TBB tasks), then combines their outputs (combiners.h) and reports
 // the time of every stage. For sweeps that reuse base outputs across combinations, call
 // runBaseDenoisers() once and combine() per combination instead. runMembersAlone() runs members
 // on one input only, without the ensemble (`chorus denoise --combine none`).
@@ -54,17 +54,20 @@ std::vector<Image> runMembersAlone(const DenoiseInput& input,
 
 // Which runs of every member the ensemble needs besides the full buffer.
 struct BaseRuns {
+  bool full = true;      // on the full buffer; else `full` is the mean of the held-out runs
   bool halves = true;    // on half A and half B
   bool heldOut = false;  // on the four inputs without one quarter (held_out_inputs.h)
 };
 // The runs an estimate needs on these sources: the quarters (and the extrapolated) estimate
-// use the held-out runs when the sources carry four independent quarters (K = 4), and then the
-// half runs are left out (the quarters estimate and the weight filter's guide need only the
-// held-out runs; the extrapolated estimate also needs the halves). Otherwise the half runs.
+// use the held-out runs when the sources carry four independent quarters (K = 4). The quarters
+// estimate then needs nothing else: the half runs are left out (the estimate and the weight
+// filter's guide read only the held-out runs) and the full run too (the ensemble blends the
+// mean of the held-out runs, meanOfHeldOutRuns). The extrapolated estimate also needs the
+// halves and keeps the full run. Otherwise the full and the half runs.
 BaseRuns baseRunsFor(const MseOptions& options, const EnsembleSources& sources);
-// Every member on sources.full and on the runs that `runs` asks for, in parallel. Appends
-// "<label>/A", "<label>/B", "<label>/full", "<label>/without-q<k>" (the time of each run) and
-// "bases" (wall time of all of them) to `times`.
+// Every member on the runs that `runs` asks for, in parallel. Appends "<label>/A",
+// "<label>/B", "<label>/full", "<label>/without-q<k>" (the time of each run) and "bases" (wall
+// time of all of them) to `times`.
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
                                           std::vector<StageTime>* times = nullptr,

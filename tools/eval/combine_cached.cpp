@@ -55,12 +55,7 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
     BaseOutputs& o = outputs[m] = readCachedMember(caseDir, m);
     alone[m] = o.full;
     if (args.noHalfRuns && o.heldOut.size() == 4) o.a = o.b = Image();
-    if (args.fullFromHeldOut && o.heldOut.size() == 4)
-      for (size_t e = 0; e < o.full.size(); ++e) {
-        float sum = 0;
-        for (const Image& run : o.heldOut) sum += run.data()[e];
-        o.full.data()[e] = 0.25f * sum;
-      }
+    if (args.fullFromHeldOut && o.heldOut.size() == 4) o.full = meanOfHeldOutRuns(o);
   }
   std::vector<sweep::SweepRow> rows = {
       sweep::measuredRow(args.name, spp, "noisy", "-", 0, guides.color, reference, 0, 0)};
@@ -88,10 +83,7 @@ void diagnose(const Args& args, const fs::path& caseDir, int spp,
               const std::vector<std::string>& methods, const Image& reference) {
   for (const std::string& m : methods) {
     const BaseOutputs o = readCachedMember(caseDir, m);
-    Image mean = o.full;
-    for (size_t e = 0; e < mean.size() && o.heldOut.size() == 4; ++e)
-      mean.data()[e] = 0.25f * (o.heldOut[0].data()[e] + o.heldOut[1].data()[e] +
-                                o.heldOut[2].data()[e] + o.heldOut[3].data()[e]);
+    const Image mean = o.heldOut.size() == 4 ? meanOfHeldOutRuns(o) : o.full;
     double heldOut = 0;
     for (const Image& run : o.heldOut) heldOut += computeMetrics(run, reference).relMse / 4;
     std::printf("%s\t%d\t%s\tA %.4g\tB %.4g\tfull %.4g\theldOut %.4g\theldOutMean %.4g\n",

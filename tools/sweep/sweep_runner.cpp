@@ -195,21 +195,32 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
   const EnsembleSources sources = sourcesFromBuffers(render.buffers);
   checkMembersCanRun(sources, plan.members);
   std::vector<StageTime> times;
-  const BaseRuns runs = baseRunsFor(config.combine.mse, sources);
+  BaseRuns runs = baseRunsFor(config.combine.mse, sources);
+  // A member alone is its full run (what a user running only it gets), so the sweep always runs
+  // it; the ensemble blends what `chorus render` blends (the held-out runs' mean, when it does).
+  const bool blendsHeldOutMeans = !runs.full;
+  runs.full = true;
   const std::vector<BaseOutputs> bases = runBaseDenoisers(sources, plan.members, &times, runs);
+  std::vector<BaseOutputs> blended;
+  if (blendsHeldOutMeans)
+    for (const BaseOutputs& b : bases)
+      blended.push_back({b.name, b.a, b.b, meanOfHeldOutRuns(b), b.heldOut});
   const EnsembleGuides guides = guidesFromSources(sources, runs.heldOut);
 
   // Times. A base denoiser alone costs one run on the full buffer (what a user running only it
-  // pays). A combination costs its members' runs on A, B, full (and the held-out inputs) plus the
-  // combine stages (solve, filter, blend): the base outputs are shared across combinations here,
-  // but a user running that one ensemble pays all of it. Runs are timed individually, so the
-  // figures are sequential costs even though the sweep runs the bases in parallel.
+  // pays). A combination costs the runs of its members that the ensemble uses (A, B, full, or
+  // the held-out inputs) plus the combine stages (solve, filter, blend): the base outputs are
+  // shared across combinations here, but a user running that one ensemble pays all of it. Runs
+  // are timed individually, so the figures are sequential costs even though the sweep runs the
+  // bases in parallel.
   std::map<std::string, const BaseOutputs*> byName;
-  std::map<std::string, double> ensembleCost;  // member → every run of it (A, B, full, held out)
-  for (const BaseOutputs& b : bases) {
+  std::map<std::string, double> ensembleCost;  // member → every run of it the ensemble uses
+  for (const BaseOutputs& b : blendsHeldOutMeans ? blended : bases) {
     byName[b.name] = &b;
     for (const StageTime& t : times)
-      if (t.stage.rfind(b.name + "/", 0) == 0) ensembleCost[b.name] += t.seconds;
+      if (t.stage.rfind(b.name + "/", 0) == 0 &&
+          !(blendsHeldOutMeans && t.stage == b.name + "/full"))
+        ensembleCost[b.name] += t.seconds;
   }
 
   CaseResult result;

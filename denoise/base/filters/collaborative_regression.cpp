@@ -450,7 +450,9 @@ class Regression {
             .insideLanes = std::min(kLanes, width_ - x0),
             .fu = &fu_};
         accumulateSums(g, st.sums, st.groupWeights.data(), st.skip.data(), st.windowRow);
-        Lanes beta[kMaxGramSize * kMaxGramRhs];
+        // Declared in baseline code, where alignof(Lanes) is only 16, and read by the AVX-512
+        // clone of accumulatePredictions, which may assume the type's full 64 bytes.
+        alignas(64) Lanes beta[kMaxGramSize * kMaxGramRhs];
         solveLanes(st.sums, std::min(kLanes, width_ - x0), beta);
         const size_t at = size_t(y - out.extent.y0) * accWidth + size_t(x0 - out.extent.x0);
         accumulatePredictions(g, st.groupWeights.data(), st.skip.data(), beta, out.acc.data(),

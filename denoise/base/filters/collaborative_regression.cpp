@@ -37,13 +37,19 @@ constexpr int kTileSize = 32;  // tile side; tiles are always kTileSize wide (se
 constexpr int kLanes = 16;
 static_assert(kTileSize % kLanes == 0);
 using Lanes = float __attribute__((vector_size(kLanes * sizeof(float))));
-[[gnu::always_inline]] inline Lanes loadLanes(const float* p) {
-  Lanes v;
+
+// A vector V from, and to, memory of its element type T at any alignment: memory outside the
+// kernels' own stack frames holds plain floats and doubles, because code built for the
+// baseline aligns these vector types to less than the AVX-512 clones assume.
+template <typename V, typename T>
+[[gnu::always_inline]] inline V loadVector(const T* p) {
+  V v;
   std::memcpy(&v, p, sizeof v);
   return v;
 }
 
-[[gnu::always_inline]] inline void storeLanes(float* p, Lanes v) {
+template <typename V, typename T>
+[[gnu::always_inline]] inline void storeVector(T* p, V v) {
   std::memcpy(p, &v, sizeof v);
 }
 
@@ -62,18 +68,6 @@ using HalfSums = double __attribute__((vector_size(kHalf * sizeof(double))));
 using SumLanes = double __attribute__((vector_size(kLanes * sizeof(double))));
 [[gnu::always_inline]] inline SumLanes wide(Lanes v) {
   return __builtin_convertvector(v, SumLanes);
-}
-
-// Memory outside the kernels' own stack frames holds plain doubles: code built for the baseline
-// aligns these vector types to less than the AVX-512 clones assume.
-[[gnu::always_inline]] inline HalfSums loadSums(const double* p) {
-  HalfSums v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-
-[[gnu::always_inline]] inline void storeSums(double* p, HalfSums v) {
-  std::memcpy(p, &v, sizeof v);
 }
 
 // Columns of the design matrix and of the data: d ≤ kMaxGramSize, C ≤ kMaxGramRhs.
@@ -102,11 +96,12 @@ struct Group {
   x[0] = splat(1.0f);
   x[1] = splat(float(dx));
   x[2] = splat(float(dy));
-  for (int j = 0; j < d - 3; ++j) x[3 + j] = loadLanes(g.fu->row(j, g.y + dy) + g.x0 + dx) - fp[j];
+  for (int j = 0; j < d - 3; ++j)
+    x[3 + j] = loadVector<Lanes>(g.fu->row(j, g.y + dy) + g.x0 + dx) - fp[j];
 }
 
 [[gnu::always_inline]] inline void centreFeatures(const Group& g, int d, Lanes* fp) {
-  for (int j = 0; j < d - 3; ++j) fp[j] = loadLanes(g.fu->row(j, g.y) + g.x0);
+  for (int j = 0; j < d - 3; ++j) fp[j] = loadVector<Lanes>(g.fu->row(j, g.y) + g.x0);
 }
 
 // exp(−41): fast_exp gives 0 below about this.
@@ -154,7 +149,7 @@ constexpr int rowBlocks(int d) {
 }
 
 [[gnu::always_inline]] inline void addTo(double* sum, HalfSums v) {
-  storeSums(sum, loadSums(sum) + v);
+  storeVector(sum, loadVector<HalfSums>(sum) + v);
 }
 
 // The window row dy's part of the sums (a, b) with a in block k: the row's sum
@@ -162,7 +157,6 @@ constexpr int rowBlocks(int d) {
 // accumulators that stays in registers over the row, instead of every sum loaded and stored
 // at every offset — is added to sums[sumIndex(a, b)]. Block 0 also adds the sums with the dy
 // column (a or b = 2): dy times the row's sums with column 0.
-template <int kD, int kC>
 [[gnu::always_inline]] inline void rowBlockSums(int d, int total, int k, const OffsetColumns* cols,
                                                 int live, int dy, double (*sums)[kHalf]) {
   const int a0 = k == 0 ? 0 : 2 * k + 1, a1 = k == 0 ? 1 : 2 * k + 2;
@@ -177,11 +171,12 @@ template <int kD, int kC>
     const OffsetColumns& o = cols[i];
     HalfSums wa[2] = {};
 #pragma GCC unroll 2
-    for (int r = 0; r < rows; ++r) wa[r] = loadSums(o.w) * loadSums(o.x[rowOf[r]]);
+    for (int r = 0; r < rows; ++r)
+      wa[r] = loadVector<HalfSums>(o.w) * loadVector<HalfSums>(o.x[rowOf[r]]);
 #pragma GCC unroll 32
     for (int b = a0; b < total; ++b) {
       if (b == 2) continue;
-      const HalfSums xb = loadSums(o.x[b]);
+      const HalfSums xb = loadVector<HalfSums>(o.x[b]);
 #pragma GCC unroll 2
       for (int r = 0; r < rows; ++r)
         if (b >= rowOf[r]) acc[r][b] += wa[r] * xb;
@@ -206,7 +201,7 @@ template <int kD, int kC, int... kBlock>
 [[gnu::always_inline]] inline void allRowBlockSums(std::integer_sequence<int, kBlock...>,
                                                    const OffsetColumns* cols, int live, int dy,
                                                    double (*sums)[kHalf]) {
-  (rowBlockSums<kD, kC>(kD, kD + kC, kBlock, cols, live, dy, sums), ...);
+  (rowBlockSums(kD, kD + kC, kBlock, cols, live, dy, sums), ...);
 }
 
 // The Gram sums of a group, in double: half[h][e] holds sum e (see kMaxSums) of the lanes
@@ -223,8 +218,8 @@ struct WindowRowScratch {
 
 // Stores the lanes of v as the two halves' columns.
 [[gnu::always_inline]] inline void storeHalves(double* lo, double* hi, SumLanes v) {
-  storeSums(lo, __builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7));
-  storeSums(hi, __builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15));
+  storeVector(lo, __builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7));
+  storeVector(hi, __builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15));
 }
 
 // A weight of exactly 0 adds exactly 0 (the values it multiplies are finite), so offsets where
@@ -246,7 +241,7 @@ template <int kD, int kC>
   Lanes fp[kMaxGramSize];
   centreFeatures(g, d, fp);
   for (int h = 0; h < 2; ++h)
-    for (int e = 0; e < count; ++e) storeSums(sums.half[h][e], HalfSums{});
+    for (int e = 0; e < count; ++e) storeVector(sums.half[h][e], HalfSums{});
   OffsetColumns* cols[2] = {scratch.columns.data(), scratch.columns.data() + side};
   for (int dy = -g.r; dy <= g.r; ++dy) {
     // Where the columns ≥ 3 of offset (0, dy) are (features, then data).
@@ -257,9 +252,9 @@ template <int kD, int kC>
       // Each offset's weights are in another plane of the table, a cache line no hardware
       // prefetcher predicts: ask for the next window row's while this one is summed.
       if (dy < g.r) __builtin_prefetch(offsetWeights(g, dx, dy + 1));
-      Lanes w = loadLanes(offsetWeights(g, dx, dy));
+      Lanes w = loadVector<Lanes>(offsetWeights(g, dx, dy));
       if (g.power > 1) w = toPower(g, w, dx, dy);
-      storeLanes(groupWeights, w);
+      storeVector(groupWeights, w);
       // Every lane +0 (weights are never negative): the bits OR-ed.
       uint64_t bits[kLanes / 2];
       std::memcpy(bits, groupWeights, sizeof bits);
@@ -270,16 +265,16 @@ template <int kD, int kC>
       OffsetColumns &lo = cols[0][live], &hi = cols[1][live];
       ++live;
       storeHalves(lo.w, hi.w, wide(w));
-      storeSums(lo.x[0], HalfSums{} + 1.0);
-      storeSums(hi.x[0], HalfSums{} + 1.0);
-      storeSums(lo.x[1], HalfSums{} + double(float(dx)));
-      storeSums(hi.x[1], HalfSums{} + double(float(dx)));
+      storeVector(lo.x[0], HalfSums{} + 1.0);
+      storeVector(hi.x[0], HalfSums{} + 1.0);
+      storeVector(lo.x[1], HalfSums{} + double(float(dx)));
+      storeVector(hi.x[1], HalfSums{} + double(float(dx)));
 #pragma GCC unroll 32
       for (int j = 0; j < d - 3; ++j)
-        storeHalves(lo.x[3 + j], hi.x[3 + j], wide(loadLanes(planes[3 + j] + dx) - fp[j]));
+        storeHalves(lo.x[3 + j], hi.x[3 + j], wide(loadVector<Lanes>(planes[3 + j] + dx) - fp[j]));
 #pragma GCC unroll 8
       for (int c = 0; c < C; ++c)
-        storeHalves(lo.x[d + c], hi.x[d + c], wide(loadLanes(planes[d + c] + dx)));
+        storeHalves(lo.x[d + c], hi.x[d + c], wide(loadVector<Lanes>(planes[d + c] + dx)));
     }
     if (live == 0) continue;  // the row would add 0 to every sum
     for (int h = 0; h < 2; ++h) {
@@ -288,7 +283,7 @@ template <int kD, int kC>
                                 sums.half[h]);
       else
         for (int k = 0; k < rowBlocks(d); ++k)
-          rowBlockSums<kD, kC>(d, total, k, cols[h], live, dy, sums.half[h]);
+          rowBlockSums(d, total, k, cols[h], live, dy, sums.half[h]);
     }
   }
 }
@@ -315,7 +310,7 @@ template <int kD, int kC>
   centreFeatures(g, d, fp);
   for (int dy = -g.r; dy <= g.r; ++dy)
     for (int dx = -g.r; dx <= g.r; ++dx) {
-      const Lanes w = loadLanes(groupWeights);
+      const Lanes w = loadVector<Lanes>(groupWeights);
       groupWeights += kLanes;
       if (*skip++) continue;
       designRow(g, d, fp, dx, dy, x);
@@ -324,10 +319,10 @@ template <int kD, int kC>
         Lanes p = beta[c];
         for (int a = 1; a < d; ++a) p += beta[a * C + c] * x[a];
         float* plane = at + size_t(c) * accPlane;
-        storeLanes(plane, loadLanes(plane) + w * p);
+        storeVector(plane, loadVector<Lanes>(plane) + w * p);
       }
       float* wsum = at + size_t(C) * accPlane;
-      storeLanes(wsum, loadLanes(wsum) + w);
+      storeVector(wsum, loadVector<Lanes>(wsum) + w);
     }
 }
 

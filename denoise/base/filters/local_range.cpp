@@ -12,27 +12,18 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// lo = min and hi = max over the taps t = −radius … radius of each row value's neighbours
-// value + t · step that lie in [0, n) (step 1 along a row's values, `channels` for the pixels
-// of a row), t in the outer loop so that the inner one runs over whole rows (vectorised).
-void minMaxRow(const float* loIn, const float* hiIn, float* loOut, float* hiOut, ptrdiff_t n,
-               int radius, ptrdiff_t step) {
-  float* __restrict lo = loOut;
-  float* __restrict hi = hiOut;
-  std::fill(lo, lo + n, kInf);
-  std::fill(hi, hi + n, -kInf);
-  for (int t = -radius; t <= radius; ++t) {
-    const ptrdiff_t shift = ptrdiff_t(t) * step;
-    const float* __restrict l = loIn + shift;
-    const float* __restrict h = hiIn + shift;
-    for (ptrdiff_t i = std::max(ptrdiff_t(0), -shift); i < std::min(n, n - shift); ++i) {
-      lo[i] = std::min(lo[i], l[i]);
-      hi[i] = std::max(hi[i], h[i]);
-    }
+// lo[i] = min(lo[i], l[i]) and hi[i] = max(hi[i], u[i]) for i in [begin, end) (vectorised).
+void takeMinMax(float* __restrict lo, float* __restrict hi, const float* __restrict l,
+                const float* __restrict u, ptrdiff_t begin, ptrdiff_t end) {
+  for (ptrdiff_t i = begin; i < end; ++i) {
+    lo[i] = std::min(lo[i], l[i]);
+    hi[i] = std::max(hi[i], u[i]);
   }
 }
 
-// One separable pass of min and max along x (horizontal) or y, in the order of the taps.
+// One separable pass of min and max along x (horizontal) or y, in the order of the taps, each
+// tap over a whole row at a time: along x the row's values shifted by t · channels (the taps
+// that lie in the row), along y the rows y − radius … y + radius that lie in the image.
 void pass(const Image& loIn, const Image& hiIn, Image& loOut, Image& hiOut, int radius,
           bool horizontal) {
   const int h = loIn.height();
@@ -40,23 +31,18 @@ void pass(const Image& loIn, const Image& hiIn, Image& loOut, Image& hiOut, int 
   parallelRows(0, h, [&](int y) {
     const ptrdiff_t at = ptrdiff_t(y) * n;
     float *lo = loOut.data() + at, *hi = hiOut.data() + at;
-    if (horizontal) {
-      minMaxRow(loIn.data() + at, hiIn.data() + at, lo, hi, n, radius, loIn.channels());
-      return;
-    }
-    // Along y: the rows y − radius … y + radius (clipped) in order, whole rows at a time.
     std::fill(lo, lo + n, kInf);
     std::fill(hi, hi + n, -kInf);
-    for (int qy = std::max(0, y - radius); qy <= std::min(h - 1, y + radius); ++qy) {
-      const float* __restrict l = loIn.data() + ptrdiff_t(qy) * n;
-      const float* __restrict u = hiIn.data() + ptrdiff_t(qy) * n;
-      float* __restrict lr = lo;
-      float* __restrict hr = hi;
-      for (ptrdiff_t i = 0; i < n; ++i) {
-        lr[i] = std::min(lr[i], l[i]);
-        hr[i] = std::max(hr[i], u[i]);
+    if (horizontal) {
+      for (int t = -radius; t <= radius; ++t) {
+        const ptrdiff_t shift = ptrdiff_t(t) * loIn.channels();
+        takeMinMax(lo, hi, loIn.data() + at + shift, hiIn.data() + at + shift,
+                   std::max(ptrdiff_t(0), -shift), std::min(n, n - shift));
       }
+      return;
     }
+    for (int qy = std::max(0, y - radius); qy <= std::min(h - 1, y + radius); ++qy)
+      takeMinMax(lo, hi, loIn.data() + ptrdiff_t(qy) * n, hiIn.data() + ptrdiff_t(qy) * n, 0, n);
   });
 }
 

@@ -126,7 +126,7 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
   if (!halfRuns && !reference && options.estimate != MseEstimate::Quarters)
     throw Error(std::string("the ") + estimateName(options.estimate) +
                 " estimate needs the members' half runs");
-  const bool quarters = (options.estimate != MseEstimate::Halves || !halfRuns) && !reference &&
+  const bool quarters = options.estimate != MseEstimate::Halves && !reference &&
                         guides.quarters.size() == 4 && bases[0]->heldOut.size() == 4;
   width_ = guides.width();
   height_ = guides.height();

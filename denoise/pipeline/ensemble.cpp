@@ -2,7 +2,9 @@
 
 #include <tbb/task_group.h>
 
+#include <functional>
 #include <set>
+#include <string>
 
 #include "common/error.h"
 #include "common/stopwatch.h"
@@ -119,19 +121,19 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
   struct Run {
     const DenoiseInput* input;
     std::string part;
-    Image BaseOutputs::*single;
-    size_t heldOut;
+    std::function<Image&(BaseOutputs&)> output;
   };
   if (!runs.full && !runs.heldOut)
     throw Error("runBaseDenoisers: without the full run the held-out runs are needed");
   std::vector<Run> plan;
-  if (runs.full) plan.push_back({&sources.full, "full", &BaseOutputs::full, 0});
+  if (runs.full) plan.push_back({&sources.full, "full", &BaseOutputs::full});
   if (runs.halves) {
-    plan.push_back({&sources.a, "A", &BaseOutputs::a, 0});
-    plan.push_back({&sources.b, "B", &BaseOutputs::b, 0});
+    plan.push_back({&sources.a, "A", &BaseOutputs::a});
+    plan.push_back({&sources.b, "B", &BaseOutputs::b});
   }
   for (size_t k = 0; k < heldOutInputList.size(); ++k)
-    plan.push_back({&heldOutInputList[k], "without-q" + std::to_string(k), nullptr, k});
+    plan.push_back({&heldOutInputList[k], "without-q" + std::to_string(k),
+                    [k](BaseOutputs& o) -> Image& { return o.heldOut[k]; }});
   const size_t parts = plan.size();
   std::vector<BaseOutputs> outputs(members.size());
   std::vector<double> seconds(members.size() * parts);
@@ -141,8 +143,7 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
     o.name = members[m].label;
     o.heldOut.resize(heldOutInputList.size());
     for (size_t part = 0; part < parts; ++part) {
-      const Run& run = plan[part];
-      Image* target = run.single ? &(o.*run.single) : &o.heldOut[run.heldOut];
+      Image* target = &plan[part].output(o);
       group.run([&, m, part, target] {
         const Stopwatch clock;
         *target = members[m].denoiser->run(*plan[part].input);

@@ -52,7 +52,7 @@ std::vector<Image> runMembersAlone(const DenoiseInput& input,
                                    std::span<const EnsembleMember> members,
                                    std::vector<StageTime>* times = nullptr);
 
-// Which runs of every member the ensemble needs besides the full buffer.
+// Which runs of every member the ensemble needs.
 struct BaseRuns {
   bool full = true;      // on the full buffer; else `full` is the mean of the held-out runs
   bool halves = true;    // on half A and half B
@@ -72,6 +72,7 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
                                           std::vector<StageTime>* times = nullptr,
                                           BaseRuns runs = {});
+
 struct EnsembleResult {
   CombineResult combined;          // image, weights, A/B blends, estimated MSE
   std::vector<BaseOutputs> bases;  // every base output (full, A/B or held out), in member order

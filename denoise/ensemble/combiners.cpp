@@ -160,19 +160,27 @@ std::vector<const Image*> outputsOf(std::span<const BaseOutputs* const> bases,
   return images;
 }
 
-// The noisy mean of every quarter but k at element e: the noisy counterpart of the runs
-// without quarter k.
-float quarterMeanWithout(const EnsembleGuides& guides, size_t k, size_t e) {
-  float sum = 0;
-  for (size_t j = 0; j < 4; ++j)
-    if (j != k) sum += guides.quarters[j].data()[e];
-  return sum / 3.0f;
-}
-
-Image quartersWithout(const EnsembleGuides& guides, size_t k) {
-  Image out(guides.width(), guides.height(), 3);
-  for (size_t e = 0; e < out.size(); ++e) out.data()[e] = quarterMeanWithout(guides, k, e);
-  return out;
+// The noisy counterpart of every run the weights are applied to: the value of its blend where
+// no base is finite, and what the noisy fallback puts there. For the runs without quarter k
+// (bases without half runs) the mean of the other three quarters.
+struct NoisyRuns {
+  const Image& full;
+  const Image& a;
+  const Image& b;
+  std::vector<Image> heldOut;
+};
+NoisyRuns noisyRunsOf(const EnsembleGuides& guides, bool halfRuns) {
+  NoisyRuns noisy{guides.color, guides.colorA, guides.colorB, {}};
+  for (size_t k = 0; k < 4 && !halfRuns; ++k) {
+    Image& without = noisy.heldOut.emplace_back(guides.width(), guides.height(), 3);
+    for (size_t e = 0; e < without.size(); ++e) {
+      float sum = 0;
+      for (size_t j = 0; j < 4; ++j)
+        if (j != k) sum += guides.quarters[j].data()[e];
+      without.data()[e] = sum / 3.0f;
+    }
+  }
+  return noisy;
 }
 
 // The weights applied to every run: full buffer, and the half runs (a, b) or, where the bases
@@ -187,17 +195,17 @@ struct Blends {
   }
 };
 Blends blendAll(const std::vector<Image>& weights, std::span<const BaseOutputs* const> bases,
-                const EnsembleGuides& guides) {
-  Blends blends{blend(weights, outputsOf(bases, &BaseOutputs::full), guides.color), {}, {}, {}};
+                const NoisyRuns& noisy) {
+  Blends blends{blend(weights, outputsOf(bases, &BaseOutputs::full), noisy.full), {}, {}, {}};
   if (bases[0]->hasHalfRuns()) {
-    blends.a = blend(weights, outputsOf(bases, &BaseOutputs::a), guides.colorA);
-    blends.b = blend(weights, outputsOf(bases, &BaseOutputs::b), guides.colorB);
+    blends.a = blend(weights, outputsOf(bases, &BaseOutputs::a), noisy.a);
+    blends.b = blend(weights, outputsOf(bases, &BaseOutputs::b), noisy.b);
     return blends;
   }
   for (size_t k = 0; k < 4; ++k) {
     std::vector<const Image*> runs;
     for (const BaseOutputs* base : bases) runs.push_back(&base->heldOut[k]);
-    blends.heldOut.push_back(blend(weights, runs, quartersWithout(guides, k)));
+    blends.heldOut.push_back(blend(weights, runs, noisy.heldOut[k]));
   }
   return blends;
 }
@@ -205,10 +213,10 @@ Blends blendAll(const std::vector<Image>& weights, std::span<const BaseOutputs* 
 // Weight filter step shared by the combiners: guided by the blend of `weights`.
 std::vector<Image> filterWeights(const std::vector<Image>& weights,
                                  const std::vector<BaseMask>& valid,
-                                 std::span<const BaseOutputs* const> bases,
+                                 std::span<const BaseOutputs* const> bases, const NoisyRuns& noisy,
                                  const EnsembleGuides& guides, const WeightFilterOptions& options,
                                  bool nonNegative) {
-  const ColorGuide guide = blendAll(weights, bases, guides).colorGuide(options);
+  const ColorGuide guide = blendAll(weights, bases, noisy).colorGuide(options);
   const std::vector<Image> filtered =
       crossBilateralFilter(weights, guide, guides.normal, guides.albedo, options);
   return renormalizeWeights(filtered, valid, weights, nonNegative);
@@ -264,6 +272,7 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
     throw Error("the " + std::string(combinerName(options.combiner)) +
                 " combiner needs a reference image");
   const int n = int(bases.size()), w = guides.width(), h = guides.height();
+  const NoisyRuns noisy = noisyRunsOf(guides, bases[0]->hasHalfRuns());
   CombineResult result;
   StageClock clock(result.times);
 
@@ -326,7 +335,7 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
         std::vector<Image> uniform = zeroMaps(n, w, h, 1);
         for (Image& map : uniform) map.fill(1.0f / float(n));
         diagonal.maps = crossBilateralFilter(
-            diagonal.maps, blendAll(uniform, bases, guides).colorGuide(options.filter),
+            diagonal.maps, blendAll(uniform, bases, noisy).colorGuide(options.filter),
             guides.normal, guides.albedo, options.filter);
       }
       result.rawWeights = argminOneHot(diagonal.maps, valid);
@@ -346,7 +355,7 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
 
   if (filter) {
     result.weights =
-        filterWeights(result.rawWeights, valid, bases, guides, options.filter, nonNegative);
+        filterWeights(result.rawWeights, valid, bases, noisy, guides, options.filter, nonNegative);
     clock.stop("filter");
   } else {
     result.weights = result.rawWeights;
@@ -366,7 +375,7 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
               i == member[p] ? 1.0f : 0.0f;
     }
   }
-  Blends blends = blendAll(result.weights, bases, guides);
+  Blends blends = blendAll(result.weights, bases, noisy);
   if (!fallback.empty()) {
     result.noisyFallback = Image(w, h, 1);
     for (int y = 0; y < h; ++y)
@@ -377,14 +386,13 @@ CombineResult combine(const EnsembleGuides& guides, std::span<const BaseOutputs*
         result.noisyFallback(x, y, 0) = 1.0f;
         ++result.noisyFallbackPixels;
         for (int c = 0; c < 3; ++c) {
-          blends.full(x, y, c) = guides.color(x, y, c);
-          if (blends.heldOut.empty()) {
-            blends.a(x, y, c) = guides.colorA(x, y, c);
-            blends.b(x, y, c) = guides.colorB(x, y, c);
+          blends.full(x, y, c) = noisy.full(x, y, c);
+          if (!blends.a.empty()) {
+            blends.a(x, y, c) = noisy.a(x, y, c);
+            blends.b(x, y, c) = noisy.b(x, y, c);
           }
-          const size_t e = (size_t(y) * size_t(w) + size_t(x)) * 3 + size_t(c);
           for (size_t k = 0; k < blends.heldOut.size(); ++k)
-            blends.heldOut[k].data()[e] = quarterMeanWithout(guides, k, e);
+            blends.heldOut[k](x, y, c) = noisy.heldOut[k](x, y, c);
         }
       }
   }

@@ -7,6 +7,7 @@
 #include <ostream>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -200,11 +201,10 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
   // it; the ensemble blends what `chorus render` blends (the held-out runs' mean, when it does).
   const bool blendsHeldOutMeans = !runs.full;
   runs.full = true;
-  const std::vector<BaseOutputs> bases = runBaseDenoisers(sources, plan.members, &times, runs);
-  std::vector<BaseOutputs> blended;
-  if (blendsHeldOutMeans)
-    for (const BaseOutputs& b : bases)
-      blended.push_back({b.name, b.a, b.b, meanOfHeldOutRuns(b), b.heldOut});
+  std::vector<BaseOutputs> bases = runBaseDenoisers(sources, plan.members, &times, runs);
+  std::vector<Image> alone;  // each member's full run, for its own row
+  for (BaseOutputs& b : bases)
+    alone.push_back(blendsHeldOutMeans ? std::exchange(b.full, meanOfHeldOutRuns(b)) : b.full);
   const EnsembleGuides guides = guidesFromSources(sources, runs.heldOut);
 
   // Times. A base denoiser alone costs one run on the full buffer (what a user running only it
@@ -215,7 +215,7 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
   // bases in parallel.
   std::map<std::string, const BaseOutputs*> byName;
   std::map<std::string, double> ensembleCost;  // member → every run of it the ensemble uses
-  for (const BaseOutputs& b : blendsHeldOutMeans ? blended : bases) {
+  for (const BaseOutputs& b : bases) {
     byName[b.name] = &b;
     for (const StageTime& t : times)
       if (t.stage.rfind(b.name + "/", 0) == 0 &&
@@ -226,16 +226,17 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
   CaseResult result;
   result.rows.push_back(
       measuredRow(c.scene, c.spp, "noisy", "-", 0, guides.color, reference, renderSeconds, 0));
-  for (const BaseOutputs& b : bases)
-    result.rows.push_back(measuredRow(c.scene, c.spp, b.name, "-", 1, b.full, reference,
-                                      renderSeconds, stageSeconds(times, b.name + "/full")));
+  for (size_t m = 0; m < bases.size(); ++m)
+    result.rows.push_back(measuredRow(c.scene, c.spp, bases[m].name, "-", 1, alone[m], reference,
+                                      renderSeconds, stageSeconds(times, bases[m].name + "/full")));
 
   const CropWindow window = worstWindow(guides.color, reference, config.cropSize);
   auto cropPng = [&](const Image& image) { return encodePng(cropImage(image, window)); };
   result.crops.scene = c.scene;
   result.crops.spp = c.spp;
   result.crops.images.push_back({"noisy", cropPng(guides.color)});
-  for (const BaseOutputs& b : bases) result.crops.images.push_back({b.name, cropPng(b.full)});
+  for (size_t m = 0; m < bases.size(); ++m)
+    result.crops.images.push_back({bases[m].name, cropPng(alone[m])});
 
   for (size_t i = 0; i < plan.combos.size(); ++i) {
     std::vector<const BaseOutputs*> members;

@@ -191,8 +191,8 @@ TEST(StiffCases, CombinationHoldsAcrossSixtyDecades) {
   const test::SyntheticScene s = scene(width, height);
   const EnsembleSources sources = sourcesFromBuffers(s.buffers);
   const std::vector<std::string> names = {"nfor", "rdfc", "atrous"};
-  const std::vector<BaseOutputs> bases =
-      runBaseDenoisers(sources, membersFromSpecs(names), nullptr, {true, true});
+  const std::vector<BaseOutputs> bases = runBaseDenoisers(
+      sources, membersFromSpecs(names), nullptr, {.full = true, .halves = true, .heldOut = true});
   const EnsembleGuides guides = guidesFromSources(sources, true);
   const Image scale = test::bandScales(width, height, {1e-30, 1e-10, 1e10, 1e30});
   EnsembleGuides scaledGuides = guides;

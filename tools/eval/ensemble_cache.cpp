@@ -96,7 +96,8 @@ void run(const Args& args) {
     if (!fs::exists(cachedMemberPath(dir, spec))) pending.push_back({spec, memberDenoiser(spec)});
   if (!pending.empty()) {
     std::vector<StageTime> times;
-    const std::vector<BaseOutputs> outputs = runBaseDenoisers(sources, pending, &times, {true, true});
+    const std::vector<BaseOutputs> outputs =
+        runBaseDenoisers(sources, pending, &times, {.full = true, .halves = true, .heldOut = true});
     for (const BaseOutputs& o : outputs) {
       std::vector<double> seconds;
       for (const StageTime& t : times)

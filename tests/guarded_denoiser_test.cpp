@@ -13,6 +13,9 @@
 #include "denoise/base/nonfinite_fill.h"
 #include "denoise/base/radiance_scale.h"
 #include "denoise/base/registry.h"
+#include "denoise/pipeline/ensemble_sources.h"
+#include "denoise/pipeline/held_out_inputs.h"
+#include "tests/support/synthetic_cases.h"
 #include "tests/support/test_support.h"
 
 namespace chorus {
@@ -145,6 +148,32 @@ TEST(KeepWithinTheSamples, BoundsOnlyWellMeasuredPixels) {
   EXPECT_EQ(out(2, 0, 0), 5.0f);
   EXPECT_EQ(out(3, 0, 0), 5.0f);
   EXPECT_NEAR(out(3, 0, 1), 2.0f, 1e-6);  // the other channels have their variance
+}
+
+TEST(GuardedDenoiser, PartialRunsAreBoundedWhereTheFullRunIs) {
+  // Four quarters of a flat image at 1 and a member that answers 5 everywhere. At 4 samples per
+  // quarter (a 16-spp render) the full run is bounded by its 16 samples, and the ensemble's
+  // held-out (12 samples) and half runs (8), which stand in for it, by their own samples as
+  // well: 1 + 10 standard errors of the input's mean. At 2 per quarter nothing is bounded.
+  for (const float perQuarter : {4.0f, 2.0f}) {
+    std::vector<SubBuffer> quarters(4, constantBuffer(6, 5, 1.0f));
+    for (SubBuffer& q : quarters) q.sampleCount.fill(perQuarter);
+    const SampleBuffers buffers(quarters);
+    const EnsembleSources sources = sourcesFromBuffers(buffers);
+    std::vector<DenoiseInput> inputs = heldOutInputs(sources);
+    inputs.push_back(sources.a);
+    inputs.push_back(sources.full);
+    Image five(6, 5, 3);
+    five.fill(5.0f);
+    const GuardedDenoiser member(synthetic::createConstantDenoiser("five", five));
+    for (const DenoiseInput& in : inputs) {
+      const double bound = 1.0 + 10.0 * std::sqrt(double(in.whole.color.varianceOfMean(2, 2, 0)));
+      ASSERT_LT(bound, 4.0);
+      const float expected = perQuarter == 4.0f ? float(bound) : 5.0f;
+      EXPECT_NEAR(member.run(in)(2, 2, 0), expected, 1e-5)
+          << in.whole.sampleCount(2, 2, 0) << " samples";
+    }
+  }
 }
 
 TEST(KeepNoiseFreeMisses, OnlyExactMissesKeepTheirInput) {

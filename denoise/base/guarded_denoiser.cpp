@@ -27,7 +27,9 @@ Image GuardedDenoiser::run(const DenoiseInput& input) const {
   scaleColor(guarded.input, -exponent);
   Image out = inner_->run(guarded.input);
   // guard=0 leaves the member's own estimate alone (only the safety steps below remain).
-  if (guard_.ceilingSigmas > 0.0f) keepWithinTheSamples(out, guarded.input.whole, kSampleSigmas);
+  if (guard_.ceilingSigmas > 0.0f)
+    keepWithinTheSamples(out, guarded.input.whole, kSampleSigmas,
+                         kMinSamplesToBound * guarded.input.sampleShare);
   finishOutput(out, guarded.input.whole.color.mean);
   scaleImage(out, exponent);
   // The input as given: the guard may have spread an excess onto such a pixel.
@@ -46,14 +48,15 @@ void finishOutput(Image& output, const Image& noisy) {
   }
 }
 
-void keepWithinTheSamples(Image& output, const SubBuffer& whole, double sigmas) {
+void keepWithinTheSamples(Image& output, const SubBuffer& whole, double sigmas,
+                          double minSamples) {
   const Image& mean = whole.color.mean;
   const Image& variance = whole.color.varianceOfMean;
   if (!output.sameShape(mean)) throw std::invalid_argument("keepWithinTheSamples: shapes differ");
   if (!whole.sampleCount.sameSize(mean)) return;
   for (int y = 0; y < mean.height(); ++y)
     for (int x = 0; x < mean.width(); ++x) {
-      if (!(whole.sampleCount(x, y, 0) >= kMinSamplesToBound)) continue;
+      if (!(whole.sampleCount(x, y, 0) >= minSamples)) continue;
       for (int c = 0; c < 3; ++c) {
         const double m = mean(x, y, c), v = variance(x, y, c);
         if (!(v > 0.0 && std::isfinite(v) && std::isfinite(m))) continue;

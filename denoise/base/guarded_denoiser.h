@@ -41,10 +41,11 @@ inline constexpr double kSampleSigmas = 10.0;
 inline constexpr float kMinSamplesToBound = 16.0f;
 
 // In place: every value of `output` within `sigmas` standard errors of `whole`'s mean at pixels
-// with at least kMinSamplesToBound samples and a positive variance of the mean. A value that far
+// with at least `minSamples` samples and a positive variance of the mean. A value that far
 // from the pixel's own samples is another pixel's radiance bled in (a thin highlight or an
 // emitter's edge spread onto a dark, well-measured neighbour), not an estimate of this one.
-void keepWithinTheSamples(Image& output, const SubBuffer& whole, double sigmas);
+void keepWithinTheSamples(Image& output, const SubBuffer& whole, double sigmas,
+                          double minSamples = kMinSamplesToBound);
 
 // In place: where every sample of `whole` missed the scene (feature depth 0: the path tracer's
 // miss) and the samples agree exactly (colour variance of the mean 0, at least 2 samples), the

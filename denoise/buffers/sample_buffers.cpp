@@ -236,7 +236,10 @@ DenoiseInput SampleBuffers::input(BufferPart which) const {
   if (which == BufferPart::Full) {
     if (k >= 2 && k % 2 == 0)
       in.halves = std::array<SubBuffer, 2>{part(BufferPart::HalfA), part(BufferPart::HalfB)};
-  } else if (k == 4) {
+    return in;
+  }
+  in.sampleShare = 0.5;
+  if (k == 4) {
     const int first = which == BufferPart::HalfA ? 0 : 2;
     in.halves = std::array<SubBuffer, 2>{sub(first), sub(first + 1)};
   }

@@ -92,6 +92,11 @@ SubBuffer merge(const std::vector<const SubBuffer*>& parts);
 struct DenoiseInput {
   SubBuffer whole;
   std::optional<std::array<SubBuffer, 2>> halves;
+  // The share of the render's samples this input holds: 1 for the full buffer, 1/2 for a half,
+  // 3/4 for a held-out input. The ensemble's partial runs stand in for the run on the full
+  // buffer, so a rule that depends on how well a pixel is measured judges by the render's count
+  // (guarded_denoiser.h's bound): a held-out run at 16 spp is bounded as the full run is.
+  double sampleShare = 1.0;
 
   int width() const { return whole.width(); }
   int height() const { return whole.height(); }

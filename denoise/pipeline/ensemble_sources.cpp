@@ -31,6 +31,7 @@ EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull) {
   if (k == 2) {  // the halves are the two sub-buffers themselves: moved, not copied
     sources.a.whole = std::move(buffers.sub(0));
     sources.b.whole = std::move(buffers.sub(1));
+    sources.a.sampleShare = sources.b.sampleShare = 0.5;
   } else {
     sources.a = buffers.input(BufferPart::HalfA);
     sources.b = buffers.input(BufferPart::HalfB);
@@ -46,6 +47,7 @@ EnsembleSources sourcesFromHalves(const DenoiseInput& input) {
   EnsembleSources sources;
   sources.a.whole = (*input.halves)[0];
   sources.b.whole = (*input.halves)[1];
+  sources.a.sampleShare = sources.b.sampleShare = 0.5 * input.sampleShare;
   sources.full = input;
   return sources;
 }

@@ -28,6 +28,7 @@ std::vector<DenoiseInput> heldOutInputs(const EnsembleSources& sources) {
     DenoiseInput& in = inputs[size_t(k)];
     in.whole = merge({&single, &intact.whole});
     in.halves = std::array<SubBuffer, 2>{single, intact.whole};
+    in.sampleShare = 0.75;
   }
   return inputs;
 }

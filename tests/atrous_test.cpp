@@ -77,6 +77,7 @@ TEST(Atrous, VectorKernelsMatchTheScalarKernelBitForBit) {
       const test::SyntheticScene scene = oddScene(unknownNormals);
       AtrousParams params;
       params.sigmaN = sigmaN;
+      params.symmetricFrom = sigmaN == 1.0f ? 0.0f : params.symmetricFrom;  // both w_l rules
       const SubBuffer& b = scene.buffers.part(BufferPart::Full);
       const Image scalar = runAtrous(b, params, AtrousKernelPath::Scalar);
       EXPECT_TRUE(test::bitIdentical(scalar, runAtrous(b, params, AtrousKernelPath::Sse2)))
@@ -159,10 +160,55 @@ TEST(Atrous, FireflyClampMeasurement) {
   EXPECT_EQ(test::firstNonFinite(Atrous(clamped).run(scene.fullInput())), "");
 }
 
+// A flat grey image (luminance 1, well measured: variance of the mean 1e-6) crossed by a
+// three-pixel vertical highlight (luminance 3, noisy: variance 1 per channel), one surface.
+DenoiseInput highlightInput(float samples, double sampleShare = 1.0) {
+  SubBuffer b = SubBuffer::zeros(32, 16);
+  b.albedo.mean.fill(0.5f);
+  b.normal.mean.fill(0.0f);
+  b.depth.mean.fill(1.0f);
+  b.sampleCount.fill(samples);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 32; ++x)
+      for (int c = 0; c < 3; ++c) {
+        b.normal.mean(x, y, 2) = 1.0f;
+        const bool stripe = x >= 15 && x <= 17;
+        b.color.mean(x, y, c) = stripe ? 3.0f : 1.0f;
+        b.color.varianceOfMean(x, y, c) = stripe ? 1.0f : 1e-6f;
+      }
+  DenoiseInput input;
+  input.whole = std::move(b);
+  input.sampleShare = sampleShare;
+  return input;
+}
+
+TEST(Atrous, NoisyHighlightKeepsItsLevelWhereTheSamplesAreTrusted) {
+  // SVGF's w_l asks only the pixel being filtered: the stripe's own tolerance (its blurred
+  // variance is large) lets it average in the grey around it, and the highlight sinks towards
+  // the grey. With the neighbours' tolerance counting too, grey pixels whose variance
+  // says they differ by thousands of standard errors keep out; only the ring next to the stripe
+  // (whose blurred variance includes the stripe's) still mixes. Measured: centre column 2.27
+  // (centre-only rule) against 2.73 (both rules), truth 3; the ring 1.16 against 1.37, truth 1.
+  const Image symmetric = Atrous().run(highlightInput(64.0f));
+  const Image centreOnly = Atrous().run(highlightInput(16.0f));
+  AtrousParams never;
+  never.symmetricFrom = 1e9f;
+  EXPECT_TRUE(test::bitIdentical(centreOnly, Atrous(never).run(highlightInput(64.0f))));
+  for (int y = 2; y < 14; ++y) {
+    EXPECT_GT(symmetric(16, y, 1), 2.6f) << y;
+    EXPECT_LT(centreOnly(16, y, 1), 2.5f) << y;
+    EXPECT_NEAR(symmetric(5, y, 1), 1.0f, 1e-3f);  // the grey far from it stays grey
+  }
+  // The render's count decides: a held-out input (3/4 of a 64-spp render's samples) is a
+  // 64-spp run.
+  EXPECT_TRUE(test::bitIdentical(Atrous().run(highlightInput(48.0f, 0.75)), symmetric));
+}
+
 TEST(Atrous, RegistryAndParameters) {
   test::expectCreates("atrous:iterations=3:sigmaN=64:demodulate=false", "atrous",
                       {.features = true, .halves = false});
-  test::expectRejected({"atrous:sigmaN=100", "atrous:iterations=-1", "atrous:sigmaL=0"});
+  test::expectRejected({"atrous:sigmaN=100", "atrous:iterations=-1", "atrous:sigmaL=0",
+                        "atrous:symmetricFrom=-1", "atrous:symmetricFrom=nan"});
   // Zero iterations: the input, exactly (demodulation off).
   test::expectIdentity("atrous:iterations=0:demodulate=false");
 }

@@ -88,7 +88,8 @@ const std::vector<std::string> kEnvironments = {
 const std::vector<std::string> kOutputs = {"{case}/out",  "{case}/out/a/b", "",   ".",
                                            "{case}/file", "{case}/out/",    "out"};
 const std::map<std::string, std::vector<std::string>> kDenoiserKeys = {
-    {"atrous", {"iterations", "sigmaL", "sigmaN", "sigmaZ", "demodulate", "clampFireflies"}},
+    {"atrous",
+     {"iterations", "sigmaL", "sigmaN", "sigmaZ", "demodulate", "clampFireflies", "symmetricFrom"}},
     {"nfor", {"regressionR", "finalR", "finalK", "epsilon", "mseR", "prefilterK"}},
     {"nlm", {"r", "f", "k", "alpha", "weightThreshold"}},
     {"sbf", {"sigmaS", "sigmaR", "sigmaN", "sigmaMse"}},

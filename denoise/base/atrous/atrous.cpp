@@ -26,10 +26,12 @@ AtrousParams AtrousParams::fromParams(ParamMap& params) {
   p.sigmaL = params.getFloat("sigmaL", p.sigmaL);
   p.demodulate = params.getBool("demodulate", p.demodulate);
   p.clampFireflies = params.getBool("clampFireflies", p.clampFireflies);
+  p.symmetricFrom = params.getFloat("symmetricFrom", p.symmetricFrom);
   if (p.iterations < 0 || p.iterations > kMaxIterations)
     throw Error("atrous: iterations must be in [0, " + std::to_string(kMaxIterations) + "]");
   if (!(p.sigmaZ > 0) || !std::isfinite(p.sigmaZ)) throw Error("atrous: sigmaZ must be > 0");
   if (!(p.sigmaL > 0) || !std::isfinite(p.sigmaL)) throw Error("atrous: sigmaL must be > 0");
+  if (!(p.symmetricFrom >= 0)) throw Error("atrous: symmetricFrom must be >= 0");
   // Powers of two only: w_n is then a chain of squarings, which vectorises.
   if (p.sigmaN != 0 && !(p.sigmaN >= 1 && p.sigmaN <= 1024 && p.sigmaN == std::floor(p.sigmaN) &&
                          std::has_single_bit(unsigned(p.sigmaN))))
@@ -38,6 +40,15 @@ AtrousParams AtrousParams::fromParams(ParamMap& params) {
 }
 
 namespace {
+
+// The mean sample count of the render this buffer comes from (0 without counts).
+double renderSamplesPerPixel(const SubBuffer& buffer, double sampleShare) {
+  const Image& counts = buffer.sampleCount;
+  if (counts.size() == 0 || !(sampleShare > 0)) return 0.0;
+  double total = 0;
+  for (float n : counts.values()) total += n;
+  return total / double(counts.size()) / sampleShare;
+}
 
 constexpr std::array<float, 3> kLuminance = {0.2126f, 0.7152f, 0.0722f};
 constexpr float kLuminanceEpsilon = 1e-10f;  // SVGF
@@ -222,7 +233,8 @@ void levelStatistics(const PaddedPlanes& state, float sigmaL, int first, int las
 
 // One à-trous level with tap spacing `step`: state → next (colour and luminance variance).
 // `statistics` is scratch for the level's luminance and inverse luminance tolerance.
-void atrousLevel(const Guide& g, const AtrousParams& params, AtrousKernelPath path, int step,
+void atrousLevel(const Guide& g, const AtrousParams& params, bool symmetric, AtrousKernelPath path,
+                 int step,
                  const PaddedPlanes& state, PaddedPlanes& statistics, PaddedPlanes& next,
                  const std::vector<float>& inside) {
   const int w = state.width(), h = state.height();
@@ -247,6 +259,7 @@ void atrousLevel(const Guide& g, const AtrousParams& params, AtrousKernelPath pa
   in.hasNormal = g.planes.plane(kHasNormal) + origin;
   in.luminance = statistics.plane(0) + origin;
   in.inverseTolerance = statistics.plane(1) + origin;
+  in.neighbourTolerance = statistics.plane(symmetric ? 1 : 2) + origin;
   in.variance = state.plane(kVariance) + origin;
   for (int c = 0; c < 3; ++c) in.color[c] = state.plane(kRed + c) + origin;
   float* const out[3] = {next.plane(kRed) + origin, next.plane(kGreen) + origin,
@@ -318,8 +331,10 @@ std::vector<float> demodulationDivisors(const SubBuffer& buffer, bool demodulate
 
 }  // namespace
 
-Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKernelPath path) {
+Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKernelPath path,
+                double sampleShare) {
   const int w = buffer.width(), h = buffer.height();
+  const bool symmetric = renderSamplesPerPixel(buffer, sampleShare) >= params.symmetricFrom;
   const float* color = buffer.color.mean.data();
   const float* colorVariance = buffer.color.varianceOfMean.data();
   const std::vector<float> divisors = demodulationDivisors(buffer, params.demodulate);
@@ -347,11 +362,15 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKerne
   if (params.clampFireflies) clampFireflies(state);
 
   const Guide guide = makeGuide(buffer, params.sigmaZ, margin);
-  PaddedPlanes statistics(w, h, 2, margin), next(w, h, kStatePlanes, margin);
+  // Planes 0 and 1: a level's luminance and inverse tolerance; plane 2: zeros, the neighbours'
+  // tolerance when it does not count (max(t_p, 0) = t_p).
+  PaddedPlanes statistics(w, h, 3, margin), next(w, h, kStatePlanes, margin);
+  if (!symmetric)
+    for (int y = 0; y < h; ++y) std::fill_n(statistics.plane(2) + statistics.index(0, y), w, 0.0f);
   std::vector<float> inside(size_t(w + 2 * margin), 0.0f);
   std::fill(inside.begin() + margin, inside.begin() + margin + w, 1.0f);
   for (int i = 0; i < params.iterations; ++i) {
-    atrousLevel(guide, params, path, 1 << i, state, statistics, next, inside);
+    atrousLevel(guide, params, symmetric, path, 1 << i, state, statistics, next, inside);
     std::swap(state, next);
   }
 
@@ -369,3 +388,4 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKerne
 }
 
 }  // namespace chorus
+

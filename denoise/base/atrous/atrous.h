@@ -19,7 +19,13 @@
 //     its square) before filtering, the result multiplied back after — except within one pixel
 //     of a pixel whose albedo is below 0.02 in every channel (a light seen directly records a
 //     black albedo in chorus's buffers; demodulated, its mixed edge pixels would leak);
-//   - optional firefly clamp (preview only, biased): luminance limited to 10× its 3×3 median.
+//   - optional firefly clamp (preview only, biased): luminance limited to 10× its 3×3 median;
+//   - from `symmetricFrom` samples per pixel on, w_l takes the larger of p's and q's inverse
+//     tolerances: SVGF's rule asks only p, so a noisy highlight (its blurred variance large)
+//     averages in the well-measured pixels around it, a bias that stays at any sample count
+//     (flight-helmet-studio 256 spp: 5.4× the noisy input). Below it the variances come from
+//     too few samples: a pixel whose few samples agree would veto every neighbour (Cornell
+//     box 4 spp: 0.024 → 0.062 relMSE with the rule on).
 #include <string>
 
 #include "denoise/base/base_denoiser.h"
@@ -35,8 +41,12 @@ struct AtrousParams {
   float sigmaL = 4.0f;          // σ_l: luminance tolerance in noise standard deviations (SVGF)
   bool demodulate = true;       // filter colour / albedo (measured: docs/members/)
   bool clampFireflies = false;  // clamp luminance to 10× the 3×3 median first (docs/members/)
+  // From this many samples per pixel of the render on, a tap's own tolerance counts too:
+  // w_l uses the larger of p's and q's inverse tolerances (the stricter), docs/members/.
+  float symmetricFrom = 32.0f;
 
-  // Reads overrides: iterations, sigmaZ, sigmaN, sigmaL, demodulate, clampFireflies.
+  // Reads overrides: iterations, sigmaZ, sigmaN, sigmaL, demodulate, clampFireflies,
+  // symmetricFrom.
   // Throws chorus::Error for a value out of range.
   static AtrousParams fromParams(ParamMap& params);
 };
@@ -45,16 +55,19 @@ struct AtrousParams {
 // or SSE2), or a narrower one. All give bit-identical results; tests compare them.
 enum class AtrousKernelPath { Widest, Avx2, Sse2, Scalar };
 
-// Runs the filter on one buffer (colour and its variance, albedo, normal, depth).
+// Runs the filter on one buffer (colour and its variance, albedo, normal, depth) that holds
+// `sampleShare` of the render's samples (DenoiseInput::sampleShare).
 Image runAtrous(const SubBuffer& buffer, const AtrousParams& params,
-                AtrousKernelPath path = AtrousKernelPath::Widest);
+                AtrousKernelPath path = AtrousKernelPath::Widest, double sampleShare = 1.0);
 
 class Atrous : public BaseDenoiser {
  public:
   explicit Atrous(AtrousParams params = {}) : params_(params) {}
   std::string name() const override { return "atrous"; }
   DenoiserRequirements requirements() const override { return {.features = true, .halves = false}; }
-  Image run(const DenoiseInput& input) const override { return runAtrous(input.whole, params_); }
+  Image run(const DenoiseInput& input) const override {
+    return runAtrous(input.whole, params_, AtrousKernelPath::Widest, input.sampleShare);
+  }
 
  private:
   AtrousParams params_;

@@ -22,6 +22,9 @@ struct AtrousLevelInputs {
   const float* inside;
   const float *z, *gx, *gy, *nx, *ny, *nz, *hasNormal;   // guide
   const float *luminance, *inverseTolerance, *variance;  // this level's luminance statistics
+  // The tolerance a tap q imposes on its own: the larger of p's and q's inverse tolerances
+  // counts. inverseTolerance itself when the variances are trusted (AtrousParams), else zeros.
+  const float* neighbourTolerance;
   const float* color[3];
 };
 
@@ -125,7 +128,8 @@ void filterPixels(const AtrousLevelInputs& in, int x, int y, float* const outCol
       F w = kernel;
       if (k != 12) {
         const F e = abs(zp - F::load(in.z + q)) * inverseDepthScale[k < 12 ? k : 24 - k] +
-                    abs(lp - F::load(in.luminance + q)) * tolerance;
+                    abs(lp - F::load(in.luminance + q)) *
+                        (tolerance + max0(F::load(in.neighbourTolerance + q) - tolerance));
         w = w * expNegated<kExpDegree>(e);
       }
       if constexpr (kSquarings >= 0) {

@@ -1,0 +1,68 @@
+#!/usr/bin/env python3
+"""The real `chorus render --preview` (K = 2, the halves estimate, its two a-trous members) on
+every rendered entry of the evaluation corpus, several seeds, against the references of a
+cached corpus (tools/eval/cached_corpus.py). The cached corpus combines the preview members from
+K = 4 renders, which is not what a preview runs; this is. Extra flags after `--` go to every
+render (e.g. `-- --splits 4`). Prints one line per render and the per-half summary."""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+
+import corpus_file
+
+
+def scene_path(reference, cache, shared):
+    root, _, rest = reference.partition(":")
+    if root == "project":
+        return os.path.join(corpus_file.REPOSITORY, rest)
+    if root == "generated":
+        return os.path.join(cache, "scenes", rest)
+    return os.path.join(shared, "scenes", rest)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--cache", default="build/eval-cache")
+    parser.add_argument("--chorus", default="build/chorus")
+    parser.add_argument("--out", required=True)
+    parser.add_argument("--seeds", default="1,2,3")
+    parser.add_argument("--shared", default=os.environ.get("CHORUS_SHARED_DIR", "../shared"))
+    parser.add_argument("flags", nargs="*")
+    args = parser.parse_args()
+    corpus = json.load(open(corpus_file.DEFAULT_CORPUS))
+    rows = []
+    for entry in corpus["entries"]:
+        if entry["source"] == "synthetic":
+            continue
+        for seed in args.seeds.split(","):
+            out = os.path.join(args.out, "%s-%s" % (entry["name"], seed))
+            command = [args.chorus, "render", scene_path(entry["scene"], args.cache, args.shared),
+                       "--preview", "--width", str(entry["width"]), "--seed", seed,
+                       "--reference", os.path.join(args.cache, entry["name"], "reference.exr"),
+                       "--out", out, "--quiet", "--threads", "2"] + args.flags
+            if entry.get("env"):
+                command += ["--env", scene_path(entry["env"], args.cache, args.shared)]
+            subprocess.run(command, check=True, stderr=subprocess.DEVNULL)
+            metrics = json.load(open(os.path.join(out, "stats.json")))["metrics"]
+            members = [v for k, v in metrics.items() if k not in ("noisy", "denoised")]
+            best = min(m["relmse"] for m in members)
+            row = (entry["name"], entry["half"], seed, metrics["denoised"]["relmse"], best,
+                   metrics["denoised"]["dssim"] <= min(m["dssim"] for m in members))
+            rows.append(row)
+            print("%-28s %-10s seed %s preview %.4g best member %.4g ratio %.3f" % (
+                row[:5] + (row[3] / best,)), flush=True)
+    for half in ("tuning", "validation"):
+        cases = [r for r in rows if r[1] == half]
+        ratios = [r[3] / r[4] for r in cases]
+        print("%s: %d renders, beats its best member %.0f%%, geometric mean %.3f, worst %.2f, "
+              "DSSIM no worse %.0f%%" % (
+                  half, len(cases), 100.0 * sum(q < 1 for q in ratios) / len(cases),
+                  math.exp(sum(map(math.log, ratios)) / len(ratios)), max(ratios),
+                  100.0 * sum(r[5] for r in cases) / len(cases)))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

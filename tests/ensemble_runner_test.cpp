@@ -180,6 +180,14 @@ TEST(EnsembleRunner, HalvesOfTheirOwnInputNeedFourSubBuffers) {
   EXPECT_THROW(ensemble.run(sources), Error);
   // One sub-buffer cannot be split at all.
   EXPECT_THROW(Ensemble(boxMembers(), {}).run(buffers(1)), Error);
+  // With the quarters estimate nothing runs on the full buffer, so its halves may be dropped
+  // (chorus render does, to save memory): the same result; with the halves estimate it refuses.
+  EnsembleSources noFullHalves = sourcesFromBuffers(four);
+  noFullHalves.full.halves.reset();
+  const Ensemble quarters(members, {});
+  EXPECT_TRUE(sameImage(quarters.run(noFullHalves).combined.image,
+                        quarters.run(four).combined.image));
+  EXPECT_THROW(ensemble.run(noFullHalves), Error);
 }
 
 // Taking the buffers over gives the same inputs as copying them (every image of every part),

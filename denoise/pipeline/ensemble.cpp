@@ -38,17 +38,18 @@ bool needsHalves(const EnsembleMember& member) {
 
 }  // namespace
 
-void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members) {
+void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members,
+                        bool fullRun) {
   checkLabels(members);
   if (members.size() > size_t(kMaxDenoisers))
     throw Error("at most " + std::to_string(kMaxDenoisers) + " base denoisers, got " +
                 std::to_string(members.size()));
   for (const EnsembleMember& member : members) {
     if (!needsHalves(member)) continue;
-    const char* missing = !sources.a.halves      ? "half A"
-                          : !sources.b.halves    ? "half B"
-                          : !sources.full.halves ? "the full buffer"
-                                                 : nullptr;
+    const char* missing = !sources.a.halves                 ? "half A"
+                          : !sources.b.halves               ? "half B"
+                          : fullRun && !sources.full.halves ? "the full buffer"
+                                                            : nullptr;
     if (missing)
       throw Error("base denoiser '" + member.label +
                   "' needs two independent halves of its own input, but " + missing +
@@ -113,51 +114,65 @@ BaseRuns baseRunsFor(const MseOptions& options, const EnsembleSources& sources) 
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
                                           std::vector<StageTime>* times, BaseRuns runs) {
-  checkMembersCanRun(sources, members);
+  checkMembersCanRun(sources, members, runs.full);
   const Stopwatch all;
-  const std::vector<DenoiseInput> heldOutInputList =
-      runs.heldOut ? heldOutInputs(sources) : std::vector<DenoiseInput>{};
-  // Every run: its input, its name in `times` and where its output goes.
-  struct Run {
-    const DenoiseInput* input;
-    std::string part;
-    std::function<Image&(BaseOutputs&)> output;
-  };
   if (!runs.full && !runs.heldOut)
     throw Error("runBaseDenoisers: without the full run the held-out runs are needed");
-  std::vector<Run> plan;
-  if (runs.full) plan.push_back({&sources.full, "full", &BaseOutputs::full});
+  // Every input: its name in `times`, where its runs' outputs go, and the input itself, or the
+  // quarter it leaves out. A held-out input is built when its runs start and freed when they
+  // end: each holds three sub-buffers of every plane (2.3 GB at 4K), and four at once did not
+  // fit a 4K render in 24 GiB.
+  struct Part {
+    std::string name;
+    std::function<Image&(BaseOutputs&)> output;
+    const DenoiseInput* input = nullptr;
+    int leftOut = -1;
+  };
+  std::vector<Part> plan;
+  if (runs.full) plan.push_back({"full", &BaseOutputs::full, &sources.full});
   if (runs.halves) {
-    plan.push_back({&sources.a, "A", &BaseOutputs::a});
-    plan.push_back({&sources.b, "B", &BaseOutputs::b});
+    plan.push_back({"A", &BaseOutputs::a, &sources.a});
+    plan.push_back({"B", &BaseOutputs::b, &sources.b});
   }
-  for (size_t k = 0; k < heldOutInputList.size(); ++k)
-    plan.push_back({&heldOutInputList[k], "without-q" + std::to_string(k),
-                    [k](BaseOutputs& o) -> Image& { return o.heldOut[k]; }});
+  if (runs.heldOut)
+    for (int k = 0; k < kHeldOutQuarters; ++k)
+      plan.push_back({"without-q" + std::to_string(k),
+                      [k](BaseOutputs& o) -> Image& { return o.heldOut[size_t(k)]; }, nullptr, k});
   const size_t parts = plan.size();
   std::vector<BaseOutputs> outputs(members.size());
-  std::vector<double> seconds(members.size() * parts);
-  tbb::task_group group;
   for (size_t m = 0; m < members.size(); ++m) {
-    BaseOutputs& o = outputs[m];
-    o.name = members[m].label;
-    o.heldOut.resize(heldOutInputList.size());
-    for (size_t part = 0; part < parts; ++part) {
-      Image* target = &plan[part].output(o);
-      group.run([&, m, part, target] {
-        const Stopwatch clock;
-        *target = members[m].denoiser->run(*plan[part].input);
-        seconds[m * parts + part] = clock.seconds();
-      });
-    }
+    outputs[m].name = members[m].label;
+    if (runs.heldOut) outputs[m].heldOut.resize(kHeldOutQuarters);
   }
-  group.wait();
+  std::vector<double> seconds(members.size() * parts);
+  const auto runParts = [&](size_t first, size_t last, const DenoiseInput* input) {
+    tbb::task_group group;
+    for (size_t part = first; part < last; ++part)
+      for (size_t m = 0; m < members.size(); ++m) {
+        Image* target = &plan[part].output(outputs[m]);
+        const DenoiseInput* in = input ? input : plan[part].input;
+        group.run([&, m, part, target, in] {
+          const Stopwatch clock;
+          *target = members[m].denoiser->run(*in);
+          seconds[m * parts + part] = clock.seconds();
+        });
+      }
+    group.wait();
+  };
+  // The inputs the sources hold all run at once, then each held-out input in turn.
+  size_t own = 0;
+  while (own < parts && plan[own].input) ++own;
+  runParts(0, own, nullptr);
+  for (size_t part = own; part < parts; ++part) {
+    const DenoiseInput input = heldOutInput(sources, plan[part].leftOut);
+    runParts(part, part + 1, &input);
+  }
   if (!runs.full)
     for (BaseOutputs& o : outputs) o.full = meanOfHeldOutRuns(o);
   if (times) {
     for (size_t m = 0; m < members.size(); ++m)
       for (size_t part = 0; part < parts; ++part)
-        times->push_back({members[m].label + "/" + plan[part].part, seconds[m * parts + part]});
+        times->push_back({members[m].label + "/" + plan[part].name, seconds[m * parts + part]});
     times->push_back({"bases", all.seconds()});
   }
   return outputs;

@@ -15,21 +15,25 @@ bool hasQuarters(const EnsembleSources& sources) {
   return sources.a.halves.has_value() && sources.b.halves.has_value();
 }
 
-std::vector<DenoiseInput> heldOutInputs(const EnsembleSources& sources) {
+DenoiseInput heldOutInput(const EnsembleSources& sources, int k) {
   if (!hasQuarters(sources))
     throw Error(
         "the leave-one-quarter-out estimate needs 4 independent sub-buffers (this input has "
         "only 2)");
-  std::vector<DenoiseInput> inputs(kHeldOutQuarters);
-  for (int k = 0; k < kHeldOutQuarters; ++k) {
-    // The intact half (the other pair of quarters) and the quarter left of k's own pair.
-    const DenoiseInput& intact = k < 2 ? sources.b : sources.a;
-    const SubBuffer& single = quarter(sources, k ^ 1);
-    DenoiseInput& in = inputs[size_t(k)];
-    in.whole = merge({&single, &intact.whole});
-    in.halves = std::array<SubBuffer, 2>{single, intact.whole};
-    in.sampleShare = 0.75;
-  }
+  if (k < 0 || k >= kHeldOutQuarters) throw Error("heldOutInput: no quarter " + std::to_string(k));
+  // The intact half (the other pair of quarters) and the quarter left of k's own pair.
+  const DenoiseInput& intact = k < 2 ? sources.b : sources.a;
+  const SubBuffer& single = quarter(sources, k ^ 1);
+  DenoiseInput in;
+  in.whole = merge({&single, &intact.whole});
+  in.halves = std::array<SubBuffer, 2>{single, intact.whole};
+  in.sampleShare = 0.75;
+  return in;
+}
+
+std::vector<DenoiseInput> heldOutInputs(const EnsembleSources& sources) {
+  std::vector<DenoiseInput> inputs;
+  for (int k = 0; k < kHeldOutQuarters; ++k) inputs.push_back(heldOutInput(sources, k));
   return inputs;
 }
 

@@ -18,7 +18,9 @@ inline constexpr int kHeldOutQuarters = 4;
 // Whether `sources` carry the four quarters (K = 4: both half inputs have halves of their own).
 bool hasQuarters(const EnsembleSources& sources);
 
-// The four inputs y^(−0) … y^(−3) are computed from. Throws chorus::Error unless hasQuarters.
+// The input y^(−k) is computed from (three sub-buffers of every plane: at 4K, 2.3 GB), and all
+// four. Throw chorus::Error unless hasQuarters (or for k outside 0 … 3).
+DenoiseInput heldOutInput(const EnsembleSources& sources, int k);
 std::vector<DenoiseInput> heldOutInputs(const EnsembleSources& sources);
 
 }  // namespace chorus

@@ -16,9 +16,12 @@ constexpr double kFixedBytes = 40.0 * (1 << 20);
 // Per pixel and sub-buffer while rendering and writing render.exr: the film's 23 float planes
 // (92 bytes) plus the write's buffers (measured 141 at K = 1, 134 per sub-buffer at K = 4).
 constexpr double kRenderBytesPerSubBuffer = 141;
-// The denoisers' inputs: copies of 23 float planes, 9 of them at K = 4 (A, B and full, each
-// with two halves), 5 at K = 2 (no halves in A and B).
+// The denoisers' inputs: copies of 23 float planes. At K = 4, 12: the sources keep 7 (A and B
+// with two halves each, the full buffer; 9 with its halves when a run needs them), the
+// held-out input being run holds 3, and the 960x540 calibration point needs 2 more. At K = 2, 5
+// (no halves in A and B).
 constexpr double kSourceBytesPerCopy = 92;
+constexpr int kSourceCopiesK4 = 12, kSourceCopiesK2 = 5;
 // Per pixel, what a member's runs and the combination add at their peak (the member
 // alone, K = 4, beyond the render and the sources). Peaks of several members did not add up
 // (480x270: nfor alone 338 MiB, nfor,rdfc,atrous 347 MiB, all seven members 328 MiB): the
@@ -49,7 +52,7 @@ uint64_t estimatePeakBytes(render::Resolution size, int splits,
   const double pixels = double(size.width) * double(size.height);
   double perPixel = splits * kRenderBytesPerSubBuffer;
   if (!members.empty()) {
-    perPixel += (splits == 4 ? 9 : 5) * kSourceBytesPerCopy;
+    perPixel += (splits == 4 ? kSourceCopiesK4 : kSourceCopiesK2) * kSourceBytesPerCopy;
     double largest = 0;
     for (const EnsembleMember& member : members) largest = std::max(largest, memberPeak(member));
     perPixel += largest + double(members.size() - 1) * kFurtherMemberBytes;

@@ -163,6 +163,9 @@ void runRender(RenderArgs args) {
     sources = args.preview
                   ? sourcesFromBuffers(std::move(result.buffers), readsHalves(denoise.members))
                   : sourcesFromBuffers(result.buffers);
+  // With the quarters estimate nothing runs on the full buffer: its halves (two copies of every
+  // plane, 1.5 GB at 4K) are not kept through the members' runs.
+  if (sources && !baseRunsFor(denoise.options.mse, *sources).full) sources->full.halves.reset();
   const Stopwatch write;
   if (!args.preview) {
     const std::vector<ExrLayer> layers = sampleBuffersToLayers(std::move(result.buffers));

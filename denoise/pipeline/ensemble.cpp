@@ -118,15 +118,14 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
   const Stopwatch all;
   if (!runs.full && !runs.heldOut)
     throw Error("runBaseDenoisers: without the full run the held-out runs are needed");
-  // Every input: its name in `times`, where its runs' outputs go, and the input itself, or the
-  // quarter it leaves out. A held-out input is built when its runs start and freed when they
-  // end: each holds three sub-buffers of every plane (2.3 GB at 4K), and four at once did not
-  // fit a 4K render in 24 GiB.
+  // Every input: its name in `times`, where its runs' outputs go, and the input (none for the
+  // held-out inputs, which come last). A held-out input is built when its runs start and freed
+  // when they end: each holds three sub-buffers of every plane (2.3 GB at 4K), and four at once
+  // did not fit a 4K render in 24 GiB.
   struct Part {
     std::string name;
     std::function<Image&(BaseOutputs&)> output;
     const DenoiseInput* input = nullptr;
-    int leftOut = -1;
   };
   std::vector<Part> plan;
   if (runs.full) plan.push_back({"full", &BaseOutputs::full, &sources.full});
@@ -134,10 +133,11 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
     plan.push_back({"A", &BaseOutputs::a, &sources.a});
     plan.push_back({"B", &BaseOutputs::b, &sources.b});
   }
+  const size_t own = plan.size();
   if (runs.heldOut)
     for (int k = 0; k < kHeldOutQuarters; ++k)
       plan.push_back({"without-q" + std::to_string(k),
-                      [k](BaseOutputs& o) -> Image& { return o.heldOut[size_t(k)]; }, nullptr, k});
+                      [k](BaseOutputs& o) -> Image& { return o.heldOut[size_t(k)]; }});
   const size_t parts = plan.size();
   std::vector<BaseOutputs> outputs(members.size());
   for (size_t m = 0; m < members.size(); ++m) {
@@ -145,6 +145,7 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
     if (runs.heldOut) outputs[m].heldOut.resize(kHeldOutQuarters);
   }
   std::vector<double> seconds(members.size() * parts);
+  // Every member on parts [first, last), on `input` or else each part's own.
   const auto runParts = [&](size_t first, size_t last, const DenoiseInput* input) {
     tbb::task_group group;
     for (size_t part = first; part < last; ++part)
@@ -159,12 +160,9 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
       }
     group.wait();
   };
-  // The inputs the sources hold all run at once, then each held-out input in turn.
-  size_t own = 0;
-  while (own < parts && plan[own].input) ++own;
-  runParts(0, own, nullptr);
+  runParts(0, own, nullptr);  // the inputs the sources hold, all at once
   for (size_t part = own; part < parts; ++part) {
-    const DenoiseInput input = heldOutInput(sources, plan[part].leftOut);
+    const DenoiseInput input = heldOutInput(sources, int(part - own));
     runParts(part, part + 1, &input);
   }
   if (!runs.full)

@@ -12,15 +12,7 @@ import subprocess
 import sys
 
 import corpus_file
-
-
-def scene_path(reference, cache, shared):
-    root, _, rest = reference.partition(":")
-    if root == "project":
-        return os.path.join(corpus_file.REPOSITORY, rest)
-    if root == "generated":
-        return os.path.join(cache, "scenes", rest)
-    return os.path.join(shared, "scenes", rest)
+from corpus import Paths
 
 
 def main():
@@ -33,18 +25,21 @@ def main():
     parser.add_argument("flags", nargs="*")
     args = parser.parse_args()
     corpus = json.load(open(corpus_file.DEFAULT_CORPUS))
+    # The cache keeps the generated scenes in CACHE/scenes, as cached_corpus.py does.
+    paths = Paths(argparse.Namespace(out=args.out, shared=args.shared,
+                                     scenes=os.path.join(args.cache, "scenes")))
     rows = []
     for entry in corpus["entries"]:
         if entry["source"] == "synthetic":
             continue
         for seed in args.seeds.split(","):
             out = os.path.join(args.out, "%s-%s" % (entry["name"], seed))
-            command = [args.chorus, "render", scene_path(entry["scene"], args.cache, args.shared),
+            command = [args.chorus, "render", paths.resolve(entry["scene"], entry["name"]),
                        "--preview", "--width", str(entry["width"]), "--seed", seed,
                        "--reference", os.path.join(args.cache, entry["name"], "reference.exr"),
                        "--out", out, "--quiet", "--threads", "2"] + args.flags
             if entry.get("env"):
-                command += ["--env", scene_path(entry["env"], args.cache, args.shared)]
+                command += ["--env", paths.resolve(entry["env"], entry["name"])]
             subprocess.run(command, check=True, stderr=subprocess.DEVNULL)
             metrics = json.load(open(os.path.join(out, "stats.json")))["metrics"]
             members = [v for k, v in metrics.items() if k not in ("noisy", "denoised")]

@@ -234,8 +234,7 @@ void levelStatistics(const PaddedPlanes& state, float sigmaL, int first, int las
 // One à-trous level with tap spacing `step`: state → next (colour and luminance variance).
 // `statistics` is scratch for the level's luminance and inverse luminance tolerance.
 void atrousLevel(const Guide& g, const AtrousParams& params, bool symmetric, AtrousKernelPath path,
-                 int step,
-                 const PaddedPlanes& state, PaddedPlanes& statistics, PaddedPlanes& next,
+                 int step, const PaddedPlanes& state, PaddedPlanes& statistics, PaddedPlanes& next,
                  const std::vector<float>& inside) {
   const int w = state.width(), h = state.height();
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
@@ -362,9 +361,9 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKerne
   if (params.clampFireflies) clampFireflies(state);
 
   const Guide guide = makeGuide(buffer, params.sigmaZ, margin);
-  // Planes 0 and 1: a level's luminance and inverse tolerance; plane 2: zeros, the neighbours'
-  // tolerance when it does not count (max(t_p, 0) = t_p).
-  PaddedPlanes statistics(w, h, 3, margin), next(w, h, kStatePlanes, margin);
+  // Planes 0 and 1: a level's luminance and inverse tolerance; without the symmetric rule a
+  // plane 2 of zeros stands for the neighbours' tolerance (max(t_p, 0) = t_p).
+  PaddedPlanes statistics(w, h, symmetric ? 2 : 3, margin), next(w, h, kStatePlanes, margin);
   if (!symmetric)
     for (int y = 0; y < h; ++y) std::fill_n(statistics.plane(2) + statistics.index(0, y), w, 0.0f);
   std::vector<float> inside(size_t(w + 2 * margin), 0.0f);
@@ -388,4 +387,3 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKerne
 }
 
 }  // namespace chorus
-

@@ -97,6 +97,21 @@ double sameSurface(double a, double b) {
   return std::exp(-0.5 * d * d);
 }
 
+// The value exceeded by exactly `rank` of values[0 … count) (0: the largest), for a small rank:
+// the running top rank + 1 in insertion order.
+float largest(const float* values, int count, int rank) {
+  std::array<float, kMaxNeighbours> top;
+  int kept = 0;
+  for (int i = 0; i < count; ++i) {
+    const float v = values[i];
+    if (kept == rank + 1 && !(v > top[size_t(rank)])) continue;
+    int j = kept < rank + 1 ? kept++ : rank;
+    for (; j > 0 && top[size_t(j - 1)] < v; --j) top[size_t(j)] = top[size_t(j - 1)];
+    top[size_t(j)] = v;
+  }
+  return top[size_t(rank)];
+}
+
 class PartGuard {
  public:
   PartGuard(const SubBuffer& part, const SubBuffer* other, const OutlierGuardOptions& options)
@@ -155,6 +170,47 @@ class PartGuard {
       }
   }
 
+  // Per channel, 1 at the pixels of row y that can be outliers: a finite value with at least
+  // kMinNeighbours finite neighbours, at most a twelfth of which reach it (the first test of
+  // guardRow, for whole rows at once: most pixels stop here). Neighbours outside the image
+  // read as NaN padding, which is neither finite nor below anything.
+  std::array<std::vector<uint8_t>, 3> candidatesOfRow(int y) const {
+    const Image& mean = part_.color.mean;
+    const int w = mean.width(), h = mean.height(), r = o_.radius;
+    const size_t padded = size_t(w + 2 * r);
+    std::vector<float> rows(size_t(2 * r + 1) * padded, std::numeric_limits<float>::quiet_NaN());
+    std::vector<int> count(static_cast<size_t>(w)), below(static_cast<size_t>(w));
+    std::array<std::vector<uint8_t>, 3> out;
+    for (int c = 0; c < 3; ++c) {
+      for (int dy = -r; dy <= r; ++dy) {
+        if (y + dy < 0 || y + dy >= h) continue;
+        float* row = rows.data() + size_t(dy + r) * padded + size_t(r);
+        for (int x = 0; x < w; ++x) row[x] = mean(x, y + dy, c);
+      }
+      const float* centre = rows.data() + size_t(r) * padded + size_t(r);
+      std::fill(count.begin(), count.end(), 0);
+      std::fill(below.begin(), below.end(), 0);
+      for (int dy = -r; dy <= r; ++dy) {
+        if (y + dy < 0 || y + dy >= h) continue;
+        for (int dx = -r; dx <= r; ++dx) {
+          if (dx == 0 && dy == 0) continue;
+          const float* q = rows.data() + size_t(dy + r) * padded + size_t(r + dx);
+          for (int x = 0; x < w; ++x) {
+            count[size_t(x)] += q[x] - q[x] == 0.0f;  // finite
+            below[size_t(x)] += q[x] < centre[x];
+          }
+        }
+      }
+      out[size_t(c)].resize(size_t(w));
+      for (int x = 0; x < w; ++x) {
+        const int n = count[size_t(x)];
+        out[size_t(c)][size_t(x)] =
+            std::isfinite(centre[x]) && n >= kMinNeighbours && n - below[size_t(x)] <= n / 12;
+      }
+    }
+    return out;
+  }
+
   size_t guardRow(int y, MeanVariance& out, std::vector<uint8_t>& changed,
                   std::vector<Excess>& excesses) const {
     const Image& mean = part_.color.mean;
@@ -162,27 +218,27 @@ class PartGuard {
     const int w = mean.width(), h = mean.height(), r = o_.radius;
     std::array<float, kMaxNeighbours> values, spreads;
     size_t clamped = 0;
+    const std::array<std::vector<uint8_t>, 3> candidates = candidatesOfRow(y);
     for (int x = 0; x < w; ++x)
       for (int c = 0; c < 3; ++c) {
+        if (!candidates[size_t(c)][size_t(x)]) continue;
         const float value = mean(x, y, c);
-        if (!std::isfinite(value)) continue;
-        int count = 0, below = 0;
+        int count = 0;
         for (int qy = std::max(0, y - r); qy <= std::min(h - 1, y + r); ++qy)
           for (int qx = std::max(0, x - r); qx <= std::min(w - 1, x + r); ++qx) {
             if (qx == x && qy == y) continue;
             const float m = mean(qx, qy, c);
             if (!std::isfinite(m)) continue;
-            below += m < value;
             values[size_t(count++)] = m;
           }
-        if (count < kMinNeighbours) continue;
-        // Q = the value exceeded by `highRank` neighbours. value > Q exactly when at most
-        // highRank neighbours reach it: most pixels stop here, before any sorting.
+        // Q = the value exceeded by `highRank` neighbours (value > Q: candidatesOfRow).
         const int highRank = count / 12;
-        if (count - below > highRank) continue;
+        // The ceiling is at least highFactor · Q: most candidates stop here, before any sorting.
+        const double high = largest(values.data(), count, highRank);
+        if (high > 0 && !(value > o_.highFactor * high)) continue;
         float* first = values.data();
+        // (The same order of the values as always: the sums below depend on it.)
         std::nth_element(first, first + highRank, first + count, std::greater<float>());
-        const double high = first[highRank];
         std::nth_element(first, first + count / 2, first + count);
         const double level = first[count / 2];
 

@@ -15,23 +15,31 @@ GuardedDenoiser::GuardedDenoiser(std::unique_ptr<BaseDenoiser> inner,
   if (!inner_) throw std::invalid_argument("GuardedDenoiser: no denoiser");
 }
 
-Image GuardedDenoiser::run(const DenoiseInput& input) const {
-  DenoiseInput prepared = input;
-  fillNonFiniteColor(prepared.whole);
-  if (prepared.halves)
-    for (SubBuffer& half : *prepared.halves) fillNonFiniteColor(half);
+PreparedInput prepareInput(const DenoiseInput& input, const OutlierGuardOptions& guard) {
+  DenoiseInput filled = input;
+  fillNonFiniteColor(filled.whole);
+  if (filled.halves)
+    for (SubBuffer& half : *filled.halves) fillNonFiniteColor(half);
   // Fireflies first: left in, a firefly of 1e20 would set the scale and push the rest of the
   // image down to where the filters' ε terms dominate.
-  GuardedInput guarded = guardOutliers(std::move(prepared), guard_);
-  const int exponent = radianceScaleExponent(guarded.input);
-  scaleColor(guarded.input, -exponent);
-  Image out = inner_->run(guarded.input);
+  PreparedInput prepared{guardOutliers(std::move(filled), guard).input, 0};
+  prepared.exponent = radianceScaleExponent(prepared.input);
+  scaleColor(prepared.input, -prepared.exponent);
+  return prepared;
+}
+
+Image GuardedDenoiser::run(const DenoiseInput& input) const {
+  return runPrepared(prepareInput(input, guard_), input);
+}
+
+Image GuardedDenoiser::runPrepared(const PreparedInput& prepared, const DenoiseInput& input) const {
+  Image out = inner_->run(prepared.input);
   // guard=0 leaves the member's own estimate alone (only the safety steps below remain).
   if (guard_.ceilingSigmas > 0.0f)
-    keepWithinTheSamples(out, guarded.input.whole, kSampleSigmas,
-                         kMinSamplesToBound * guarded.input.sampleShare);
-  finishOutput(out, guarded.input.whole.color.mean);
-  scaleImage(out, exponent);
+    keepWithinTheSamples(out, prepared.input.whole, kSampleSigmas,
+                         kMinSamplesToBound * prepared.input.sampleShare);
+  finishOutput(out, prepared.input.whole.color.mean);
+  scaleImage(out, prepared.exponent);
   // The input as given: the guard may have spread an excess onto such a pixel.
   keepNoiseFreeMisses(out, input.whole);
   return out;
@@ -48,8 +56,7 @@ void finishOutput(Image& output, const Image& noisy) {
   }
 }
 
-void keepWithinTheSamples(Image& output, const SubBuffer& whole, double sigmas,
-                          double minSamples) {
+void keepWithinTheSamples(Image& output, const SubBuffer& whole, double sigmas, double minSamples) {
   const Image& mean = whole.color.mean;
   const Image& variance = whole.color.varianceOfMean;
   if (!output.sameShape(mean)) throw std::invalid_argument("keepWithinTheSamples: shapes differ");

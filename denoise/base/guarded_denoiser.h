@@ -17,6 +17,16 @@
 
 namespace chorus {
 
+// Steps 1–3 applied to an input: what every guarded member with these options runs on. The
+// ensemble prepares each input once for all its members that share the options
+// (denoise/pipeline/member_runner.h), instead of once per member: one copy of the input
+// instead of one per member running at the same time.
+struct PreparedInput {
+  DenoiseInput input;
+  int exponent = 0;  // its colour was divided by 2^exponent (radiance_scale.h)
+};
+PreparedInput prepareInput(const DenoiseInput& input, const OutlierGuardOptions& guard);
+
 class GuardedDenoiser : public BaseDenoiser {
  public:
   explicit GuardedDenoiser(std::unique_ptr<BaseDenoiser> inner,
@@ -25,6 +35,10 @@ class GuardedDenoiser : public BaseDenoiser {
   std::string name() const override { return inner_->name(); }
   DenoiserRequirements requirements() const override { return inner_->requirements(); }
   Image run(const DenoiseInput& input) const override;
+
+  const OutlierGuardOptions& guard() const { return guard_; }
+  // run(input) with steps 1–3 already done: `prepared` is prepareInput(input, guard()).
+  Image runPrepared(const PreparedInput& prepared, const DenoiseInput& input) const;
 
  private:
   std::unique_ptr<BaseDenoiser> inner_;

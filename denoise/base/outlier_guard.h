@@ -41,6 +41,7 @@ struct OutlierGuardOptions {
   float confirmSigmas = 2.5f;
   float peerSigmas = 6.0f;
   int spreadRadius = 6;
+  bool operator==(const OutlierGuardOptions&) const = default;
 };
 
 struct GuardedInput {

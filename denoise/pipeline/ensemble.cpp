@@ -3,6 +3,7 @@
 #include <tbb/task_group.h>
 
 #include <functional>
+#include <memory>
 #include <set>
 #include <string>
 
@@ -11,6 +12,7 @@
 #include "denoise/base/registry.h"
 #include "denoise/ensemble/ensemble_types.h"
 #include "denoise/pipeline/held_out_inputs.h"
+#include "denoise/pipeline/member_runner.h"
 
 namespace chorus {
 
@@ -73,11 +75,12 @@ std::vector<Image> runMembersAlone(const DenoiseInput& input,
   const Stopwatch all;
   std::vector<Image> outputs(members.size());
   std::vector<double> seconds(members.size());
+  const MemberRunner runner(input, members);
   tbb::task_group group;
   for (size_t m = 0; m < members.size(); ++m)
     group.run([&, m] {
       const Stopwatch run;
-      outputs[m] = members[m].denoiser->run(input);
+      outputs[m] = runner.run(m);
       seconds[m] = run.seconds();
     });
   group.wait();
@@ -147,14 +150,21 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
   std::vector<double> seconds(members.size() * parts);
   // Every member on parts [first, last), on `input` or else each part's own.
   const auto runParts = [&](size_t first, size_t last, const DenoiseInput* input) {
+    std::vector<std::unique_ptr<const MemberRunner>> runners(last - first);
     tbb::task_group group;
+    for (size_t part = first; part < last; ++part)
+      group.run([&, part] {
+        runners[part - first] =
+            std::make_unique<const MemberRunner>(input ? *input : *plan[part].input, members);
+      });
+    group.wait();
     for (size_t part = first; part < last; ++part)
       for (size_t m = 0; m < members.size(); ++m) {
         Image* target = &plan[part].output(outputs[m]);
-        const DenoiseInput* in = input ? input : plan[part].input;
-        group.run([&, m, part, target, in] {
+        const MemberRunner* runner = runners[part - first].get();
+        group.run([&, m, part, target, runner] {
           const Stopwatch clock;
-          *target = members[m].denoiser->run(*in);
+          *target = runner->run(m);
           seconds[m * parts + part] = clock.seconds();
         });
       }

@@ -16,12 +16,13 @@ constexpr double kFixedBytes = 40.0 * (1 << 20);
 // Per pixel and sub-buffer while rendering and writing render.exr: the film's 23 float planes
 // (92 bytes) plus the write's buffers (measured 141 at K = 1, 134 per sub-buffer at K = 4).
 constexpr double kRenderBytesPerSubBuffer = 141;
-// The denoisers' inputs: copies of 23 float planes. At K = 4, 12: the sources keep 7 (A and B
-// with two halves each, the full buffer; 9 with its halves when a run needs them), the
-// held-out input being run holds 3, and the 960x540 calibration point needs 2 more. At K = 2, 5
-// (no halves in A and B).
+// The denoisers' inputs: copies of 23 float planes. At K = 4, 9: the sources keep 7 (A and B
+// with two halves each, the full buffer; 9 with its halves when a run needs them) and the
+// held-out input being run holds 3, prepared once for all members (member_runner.h), less what
+// is freed by then (measured 6.6-7.5; 9 keeps the estimate 5-8 % above every calibration
+// point). At K = 2, 5 (no halves in A and B).
 constexpr double kSourceBytesPerCopy = 92;
-constexpr int kSourceCopiesK4 = 12, kSourceCopiesK2 = 5;
+constexpr int kSourceCopiesK4 = 9, kSourceCopiesK2 = 5;
 // Per pixel, what a member's runs and the combination add at their peak (the member
 // alone, K = 4, beyond the render and the sources). Peaks of several members did not add up
 // (480x270: nfor alone 338 MiB, nfor,rdfc,atrous 347 MiB, all seven members 328 MiB): the

@@ -38,6 +38,26 @@ TEST(Sbf, SelectsWideFiltersInFlatRegions) {
   EXPECT_GT(wide, flat / 2) << wide << " of " << flat;
 }
 
+// The SURE maps' smoothing width falls as 16/√spp within [2, 8] (sbf.h), and the default
+// parameters use it with the buffer's own mean sample count.
+TEST(Sbf, SureSmoothingFollowsTheSampleCount) {
+  EXPECT_FLOAT_EQ(sureSmoothingWidth(1), 8.0f);
+  EXPECT_FLOAT_EQ(sureSmoothingWidth(4), 8.0f);
+  EXPECT_FLOAT_EQ(sureSmoothingWidth(16), 4.0f);
+  EXPECT_FLOAT_EQ(sureSmoothingWidth(64), 2.0f);
+  EXPECT_FLOAT_EQ(sureSmoothingWidth(1024), 2.0f);
+  EXPECT_FLOAT_EQ(sureSmoothingWidth(0), 8.0f);  // no sample count recorded
+  const SubBuffer whole = test::syntheticScene(48).fullInput().whole;
+  const double spp = meanSampleCount(whole);
+  ASSERT_GT(spp, 4.0);  // so that the width is not the old fixed 8
+  SbfParams fixed;
+  fixed.sigmaMse = sureSmoothingWidth(spp);
+  const Image automatic = runSbf(whole, SbfParams{}).output;
+  EXPECT_TRUE(test::bitIdentical(automatic, runSbf(whole, fixed).output));
+  fixed.sigmaMse = 8.0f;
+  EXPECT_FALSE(test::bitIdentical(automatic, runSbf(whole, fixed).output));
+}
+
 TEST(Sbf, ConstantStaysConstantAndBlackStaysBlack) {
   test::expectConstantStaysConstant(Sbf(), 1e-5f);
   test::expectBlackStaysBlack(Sbf());

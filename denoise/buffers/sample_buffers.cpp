@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -244,6 +245,14 @@ DenoiseInput SampleBuffers::input(BufferPart which) const {
     in.halves = std::array<SubBuffer, 2>{sub(first), sub(first + 1)};
   }
   return in;
+}
+
+double meanSampleCount(const SubBuffer& buffer) {
+  double sum = 0;
+  size_t count = 0;
+  for (float n : buffer.sampleCount.values())
+    if (std::isfinite(n) && n > 0) sum += n, ++count;
+  return count > 0 ? sum / double(count) : 0.0;
 }
 
 }  // namespace chorus

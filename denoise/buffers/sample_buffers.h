@@ -81,6 +81,9 @@ struct SubBuffer {
   BufferPlanes planes() const;
 };
 
+// The mean sample count over the pixels that record one (0 when the buffer records none).
+double meanSampleCount(const SubBuffer& buffer);
+
 // Exact merge of independent sub-buffers (Chan et al.'s parallel mean/M2 update, weighted by
 // sample counts): the result equals accumulating all their samples into one buffer. The parts
 // must hold the same planes; the result holds them too.

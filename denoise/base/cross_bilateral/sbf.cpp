@@ -59,9 +59,14 @@ SbfParams SbfParams::fromParams(ParamMap& params) {
   requirePositive(p.sigmaN, "sigmaN");
   requirePositive(p.sigmaR, "sigmaR");
   requirePositive(p.sigmaD, "sigmaD");
-  requirePositive(p.sigmaMse, "sigmaMse");
+  if (!(p.sigmaMse >= 0)) throw Error("sbf: sigmaMse must be 0 (from the samples) or positive");
   if (p.sigmaMse > 64) throw Error("sbf: sigmaMse must be ≤ 64");
   return p;
+}
+
+float sureSmoothingWidth(double spp) {
+  if (!(spp > 0)) return 8.0f;
+  return float(std::clamp(16.0 / std::sqrt(spp), 2.0, 8.0));
 }
 
 SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params) {
@@ -94,7 +99,9 @@ SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params) {
       });
 
   // 3. Smooth the SURE maps (the raw per-pixel estimates are far too noisy to select with).
-  const PlanarImage smoothed = crossBilateralSmooth(sure, guide, params.sigmaMse);
+  const float sigmaMse =
+      params.sigmaMse > 0 ? params.sigmaMse : sureSmoothingWidth(meanSampleCount(buffer));
+  const PlanarImage smoothed = crossBilateralSmooth(sure, guide, sigmaMse);
 
   // 4. Hard per-pixel selection; ties go to the first candidate in sigmaS order.
   SbfResult result{Image(w, h, 3), Image(w, h, 1)};

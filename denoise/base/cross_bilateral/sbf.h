@@ -21,11 +21,12 @@ struct SbfParams {
   // Candidate spatial widths σ_s in pixels (window radius round(2σ_s); 0 = the noisy input).
   // The paper's set was not found in the indexed sources: {0, 1, 2, 4, 8} is our assumption.
   std::vector<float> sigmaS = {0, 1, 2, 4, 8};
-  float sigmaN = 0.8f;    // normal range width (release / pbrt-v3 port default)
-  float sigmaR = 0.25f;   // reflectance (albedo, "texture") range width (same source)
-  float sigmaD = 0.6f;    // depth range width, depth divided by the largest finite depth
-  float sigmaMse = 8.0f;  // spatial width of the SURE-map smoothing (final image; 4 while
-                          // sampling adaptively in the release)
+  float sigmaN = 0.8f;   // normal range width (release / pbrt-v3 port default)
+  float sigmaR = 0.25f;  // reflectance (albedo, "texture") range width (same source)
+  float sigmaD = 0.6f;   // depth range width, depth divided by the largest finite depth
+  // Spatial width of the SURE-map smoothing; 0 (default): sureSmoothingWidth of the buffer's
+  // samples per pixel (the release uses 8 for the final image, 4 while sampling adaptively).
+  float sigmaMse = 0.0f;
 
   // Reads overrides: sigmaS=0/1/2/4/8 (slash-separated), sigmaN, sigmaR, sigmaD, sigmaMse.
   // Throws chorus::Error for a value out of range.
@@ -36,6 +37,14 @@ struct SbfResult {
   Image output;     // RGB
   Image selection;  // 1 channel: index into sigmaS of the candidate chosen per pixel
 };
+
+// The SURE maps' smoothing width for a buffer with `spp` samples per pixel: 16/√spp pixels,
+// within [2, 8]. A pixel's SURE is as noisy as its colour (standard deviation ∝ 1/√spp), so the
+// area that averages it to a given precision shrinks as 1/spp, its width as 1/√spp; a fixed 8
+// averages fine detail away at high spp, where SBF then picks a wide candidate over detail that
+// its own samples resolve. Chosen on the corpus's tuning half
+// (docs/members/sbf-atrous-bilateral.md).
+float sureSmoothingWidth(double spp);
 
 // Runs SBF on one buffer (colour, its variance of the mean, normal, albedo, depth, sample count).
 SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <iostream>
+#include <tuple>
 
 #include "denoise/metrics/metrics.h"
 #include "tests/support/denoiser_checks.h"
@@ -189,9 +190,11 @@ TEST(Atrous, NoisyHighlightKeepsItsLevelWhereTheSamplesAreTrusted) {
   // says they differ by thousands of standard errors keep out; only the ring next to the stripe
   // (whose blurred variance includes the stripe's) still mixes. Measured: centre column 2.27
   // (centre-only rule) against 2.73 (both rules), truth 3; the ring 1.16 against 1.37, truth 1.
-  const Image symmetric = Atrous().run(highlightInput(64.0f));
-  const Image centreOnly = Atrous().run(highlightInput(16.0f));
-  AtrousParams never;
+  AtrousParams five;  // the same levels at 16 and 64 spp (iterationsForSamples would differ)
+  five.iterations = 5;
+  const Image symmetric = Atrous(five).run(highlightInput(64.0f));
+  const Image centreOnly = Atrous(five).run(highlightInput(16.0f));
+  AtrousParams never = five;
   never.symmetricFrom = 1e9f;
   EXPECT_TRUE(test::bitIdentical(centreOnly, Atrous(never).run(highlightInput(64.0f))));
   for (int y = 2; y < 14; ++y) {
@@ -201,13 +204,34 @@ TEST(Atrous, NoisyHighlightKeepsItsLevelWhereTheSamplesAreTrusted) {
   }
   // The render's count decides: a held-out input (3/4 of a 64-spp render's samples) is a
   // 64-spp run.
-  EXPECT_TRUE(test::bitIdentical(Atrous().run(highlightInput(48.0f, 0.75)), symmetric));
+  EXPECT_TRUE(test::bitIdentical(Atrous(five).run(highlightInput(48.0f, 0.75)), symmetric));
+}
+
+// Without `iterations` the levels follow the render's samples per pixel (atrous.h): 5 up to
+// 22 spp, 4 at 32, 3 at 64, 2 from 91 on; a held-out input counts the render's samples.
+TEST(Atrous, LevelsFollowTheRendersSamples) {
+  EXPECT_EQ(iterationsForSamples(4), 5);
+  EXPECT_EQ(iterationsForSamples(16), 5);
+  EXPECT_EQ(iterationsForSamples(32), 4);
+  EXPECT_EQ(iterationsForSamples(64), 3);
+  EXPECT_EQ(iterationsForSamples(256), 2);
+  EXPECT_EQ(iterationsForSamples(4096), 2);
+  EXPECT_EQ(iterationsForSamples(0), 5);  // no sample count recorded
+  for (const auto& [spp, share, levels] :
+       {std::tuple{16.0f, 1.0, 5}, std::tuple{64.0f, 1.0, 3}, std::tuple{48.0f, 0.75, 3},
+        std::tuple{256.0f, 1.0, 2}}) {
+    AtrousParams fixed;
+    fixed.iterations = levels;
+    EXPECT_TRUE(test::bitIdentical(Atrous().run(highlightInput(spp, share)),
+                                   Atrous(fixed).run(highlightInput(spp, share))))
+        << spp;
+  }
 }
 
 TEST(Atrous, RegistryAndParameters) {
   test::expectCreates("atrous:iterations=3:sigmaN=64:demodulate=false", "atrous",
                       {.features = true, .halves = false});
-  test::expectRejected({"atrous:sigmaN=100", "atrous:iterations=-1", "atrous:sigmaL=0",
+  test::expectRejected({"atrous:sigmaN=100", "atrous:iterations=-2", "atrous:sigmaL=0",
                         "atrous:symmetricFrom=-1", "atrous:symmetricFrom=nan"});
   // Zero iterations: the input, exactly (demodulation off).
   test::expectIdentity("atrous:iterations=0:demodulate=false");

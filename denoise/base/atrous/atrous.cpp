@@ -27,8 +27,9 @@ AtrousParams AtrousParams::fromParams(ParamMap& params) {
   p.demodulate = params.getBool("demodulate", p.demodulate);
   p.clampFireflies = params.getBool("clampFireflies", p.clampFireflies);
   p.symmetricFrom = params.getFloat("symmetricFrom", p.symmetricFrom);
-  if (p.iterations < 0 || p.iterations > kMaxIterations)
-    throw Error("atrous: iterations must be in [0, " + std::to_string(kMaxIterations) + "]");
+  if (p.iterations < kIterationsFromSamples || p.iterations > kMaxIterations)
+    throw Error("atrous: iterations must be in [0, " + std::to_string(kMaxIterations) +
+                "], or -1 (from the samples per pixel)");
   if (!(p.sigmaZ > 0) || !std::isfinite(p.sigmaZ)) throw Error("atrous: sigmaZ must be > 0");
   if (!(p.sigmaL > 0) || !std::isfinite(p.sigmaL)) throw Error("atrous: sigmaL must be > 0");
   if (!(p.symmetricFrom >= 0)) throw Error("atrous: symmetricFrom must be >= 0");
@@ -330,10 +331,19 @@ std::vector<float> demodulationDivisors(const SubBuffer& buffer, bool demodulate
 
 }  // namespace
 
-Image runAtrous(const SubBuffer& buffer, const AtrousParams& params, AtrousKernelPath path,
+int iterationsForSamples(double spp) {
+  if (!(spp > 0)) return 5;
+  return int(std::clamp(std::lround(9.0 - std::log2(spp)), 2L, 5L));
+}
+
+Image runAtrous(const SubBuffer& buffer, const AtrousParams& given, AtrousKernelPath path,
                 double sampleShare) {
   const int w = buffer.width(), h = buffer.height();
-  const bool symmetric = renderSamplesPerPixel(buffer, sampleShare) >= params.symmetricFrom;
+  const double renderSpp = renderSamplesPerPixel(buffer, sampleShare);
+  AtrousParams params = given;
+  if (params.iterations == AtrousParams::kIterationsFromSamples)
+    params.iterations = iterationsForSamples(renderSpp);
+  const bool symmetric = renderSpp >= params.symmetricFrom;
   const float* color = buffer.color.mean.data();
   const float* colorVariance = buffer.color.varianceOfMean.data();
   const std::vector<float> divisors = demodulationDivisors(buffer, params.demodulate);

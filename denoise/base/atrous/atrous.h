@@ -35,7 +35,10 @@ namespace chorus {
 
 struct AtrousParams {
   static constexpr int kMaxIterations = 6;  // the zero margins grow as 2^iterations
-  int iterations = 5;           // N: à-trous levels, tap spacing 2^i (5 → a 125-pixel footprint)
+  static constexpr int kIterationsFromSamples = -1;
+  // N: à-trous levels, tap spacing 2^i (5 → a 125-pixel footprint); kIterationsFromSamples
+  // (default, also `iterations=-1`): iterationsForSamples of the render's samples per pixel.
+  int iterations = kIterationsFromSamples;
   float sigmaZ = 1.0f;          // σ_z: depth tolerance in units of the depth gradient (SVGF)
   float sigmaN = 128.0f;        // σ_n: exponent of the normal weight (SVGF)
   float sigmaL = 4.0f;          // σ_l: luminance tolerance in noise standard deviations (SVGF)
@@ -50,6 +53,13 @@ struct AtrousParams {
   // Throws chorus::Error for a value out of range.
   static AtrousParams fromParams(ParamMap& params);
 };
+
+// The levels for a render of `spp` samples per pixel: round(9 − log2 spp) within [2, 5], i.e.
+// 5 up to 22 spp, 4 at 32, 3 at 64, 2 from 91 on (5 without a sample count). The edge-stopping
+// tolerances follow the noise, but every level still averages what lies within them, and the
+// detail below the tolerance that a wide footprint averages away is the error once the noise
+// is small. Chosen on the corpus's tuning half (docs/members/sbf-atrous-bilateral.md).
+int iterationsForSamples(double spp);
 
 // Which implementation of the inner kernel runs: the widest the CPU supports (AVX-512F, AVX2
 // or SSE2), or a narrower one. All give bit-identical results; tests compare them.

@@ -1,7 +1,8 @@
 // The Ensemble runner: runs every member on the full buffer and on half A and half B or the four
 // held-out inputs (exactly what running the denoiser on those inputs gives), combines, reports
 // every stage's time, refuses members that cannot run on the given sub-buffers, and is
-// deterministic.
+// deterministic; MemberRunner, which prepares an input once for the members sharing a guard,
+// gives each member exactly its own run's output.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -10,9 +11,11 @@
 #include <set>
 
 #include "common/error.h"
+#include "denoise/base/outlier_guard.h"
 #include "denoise/metrics/metrics.h"
 #include "denoise/pipeline/ensemble.h"
 #include "denoise/pipeline/held_out_inputs.h"
+#include "denoise/pipeline/member_runner.h"
 #include "tests/support/synthetic_cases.h"
 
 namespace chorus {
@@ -185,8 +188,8 @@ TEST(EnsembleRunner, HalvesOfTheirOwnInputNeedFourSubBuffers) {
   EnsembleSources noFullHalves = sourcesFromBuffers(four);
   noFullHalves.full.halves.reset();
   const Ensemble quarters(members, {});
-  EXPECT_TRUE(sameImage(quarters.run(noFullHalves).combined.image,
-                        quarters.run(four).combined.image));
+  EXPECT_TRUE(
+      sameImage(quarters.run(noFullHalves).combined.image, quarters.run(four).combined.image));
   EXPECT_THROW(ensemble.run(noFullHalves), Error);
 }
 
@@ -263,6 +266,35 @@ TEST(EnsembleRunner, BetterThanItsMembersOnANoisyRender) {
   const double ensemble = relMse(result.combined.image, truth);
   for (const BaseOutputs& base : result.bases)
     EXPECT_LT(ensemble, relMse(base.full, truth)) << base.name;
+}
+
+bool identical(const Image& a, const Image& b) {
+  if (!a.sameShape(b)) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (a.data()[i] != b.data()[i]) return false;
+  return true;
+}
+
+TEST(MemberRunner, EveryMemberGetsExactlyItsOwnRunsOutput) {
+  // Bright emitters with fireflies, so that the guard clamps values and the preparations for
+  // the default guard and for guard=0 differ.
+  const synthetic::Scene scene = synthetic::makeScene(synthetic::SceneKind::Hdr, 40, 32);
+  const SampleBuffers buffers = synthetic::renderBuffers(scene, {1.0f, 2, 0.03f}, 4, 5);
+  const EnsembleSources sources = sourcesFromBuffers(buffers);
+  std::vector<EnsembleMember> members =
+      membersFromSpecs(std::vector<std::string>{"atrous", "nfor", "atrous:guard=0", "sbf"});
+  members.push_back({"box1", synthetic::createSyntheticDenoiser("box1")});  // not guarded
+
+  for (const DenoiseInput& input : {sources.full, heldOutInput(sources, 2)}) {
+    ASSERT_GT(guardOutliers(input).clampedValues, 0u);
+    const MemberRunner runner(input, members);
+    std::vector<Image> shared;
+    for (size_t m = 0; m < members.size(); ++m) {
+      shared.push_back(runner.run(m));
+      EXPECT_TRUE(identical(shared.back(), members[m].denoiser->run(input))) << members[m].label;
+    }
+    EXPECT_FALSE(identical(shared[0], shared[2])) << "atrous with and without the guard";
+  }
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -248,11 +247,11 @@ DenoiseInput SampleBuffers::input(BufferPart which) const {
 }
 
 double meanSampleCount(const SubBuffer& buffer) {
-  double sum = 0;
-  size_t count = 0;
-  for (float n : buffer.sampleCount.values())
-    if (std::isfinite(n) && n > 0) sum += n, ++count;
-  return count > 0 ? sum / double(count) : 0.0;
+  const Image& counts = buffer.sampleCount;
+  if (counts.size() == 0) return 0.0;
+  double total = 0;
+  for (float n : counts.values()) total += n;
+  return total / double(counts.size());
 }
 
 }  // namespace chorus

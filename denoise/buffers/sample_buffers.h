@@ -81,7 +81,7 @@ struct SubBuffer {
   BufferPlanes planes() const;
 };
 
-// The mean sample count over the pixels that record one (0 when the buffer records none).
+// The mean sample count over the pixels (0 when the buffer records none).
 double meanSampleCount(const SubBuffer& buffer);
 
 // Exact merge of independent sub-buffers (Chan et al.'s parallel mean/M2 update, weighted by

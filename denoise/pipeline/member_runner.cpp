@@ -4,21 +4,17 @@ namespace chorus {
 
 MemberRunner::MemberRunner(const DenoiseInput& input, std::span<const EnsembleMember> members)
     : input_(input), members_(members) {
-  std::vector<const OutlierGuardOptions*> guards;
-  for (const EnsembleMember& member : members) {
-    const auto* guarded = dynamic_cast<const GuardedDenoiser*>(member.denoiser.get());
+  for (size_t m = 0; m < members.size(); ++m) {
+    const auto* guarded = dynamic_cast<const GuardedDenoiser*>(members[m].denoiser.get());
     guarded_.push_back(guarded);
-    int index = -1;
-    if (guarded) {
-      for (size_t k = 0; k < guards.size() && index < 0; ++k)
-        if (*guards[k] == guarded->guard()) index = int(k);
-      if (index < 0) {
-        index = int(guards.size());
-        guards.push_back(&guarded->guard());
-        prepared_.push_back(prepareInput(input, guarded->guard()));
-      }
-    }
-    preparedOf_.push_back(index);
+    preparedOf_.push_back(-1);
+    if (!guarded) continue;
+    // An earlier member with the same guard has prepared the input already.
+    for (size_t j = 0; j < m && preparedOf_[m] < 0; ++j)
+      if (guarded_[j] && guarded_[j]->guard() == guarded->guard()) preparedOf_[m] = preparedOf_[j];
+    if (preparedOf_[m] >= 0) continue;
+    preparedOf_[m] = int(prepared_.size());
+    prepared_.push_back(prepareInput(input, guarded->guard()));
   }
 }
 

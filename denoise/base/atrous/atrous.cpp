@@ -44,11 +44,7 @@ namespace {
 
 // The mean sample count of the render this buffer comes from (0 without counts).
 double renderSamplesPerPixel(const SubBuffer& buffer, double sampleShare) {
-  const Image& counts = buffer.sampleCount;
-  if (counts.size() == 0 || !(sampleShare > 0)) return 0.0;
-  double total = 0;
-  for (float n : counts.values()) total += n;
-  return total / double(counts.size()) / sampleShare;
+  return sampleShare > 0 ? meanSampleCount(buffer) / sampleShare : 0.0;
 }
 
 constexpr std::array<float, 3> kLuminance = {0.2126f, 0.7152f, 0.0722f};

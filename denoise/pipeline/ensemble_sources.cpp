@@ -14,13 +14,17 @@ void checkSplitCount(int k) {
 
 }  // namespace
 
-EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers) {
+EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers, bool halvesOfFull) {
   checkSplitCount(buffers.splitCount());
   EnsembleSources sources{buffers.input(BufferPart::HalfA), buffers.input(BufferPart::HalfB), {}};
-  // The full buffer's halves are the half inputs' wholes: copied rather than merged again.
   sources.full.whole = buffers.part(BufferPart::Full);
-  sources.full.halves = std::array<SubBuffer, 2>{sources.a.whole, sources.b.whole};
+  if (halvesOfFull) addHalvesOfFull(sources);
   return sources;
+}
+
+void addHalvesOfFull(EnsembleSources& sources) {
+  // The full buffer's halves are the half inputs' wholes: copied rather than merged again.
+  sources.full.halves = std::array<SubBuffer, 2>{sources.a.whole, sources.b.whole};
 }
 
 EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull) {
@@ -36,8 +40,7 @@ EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull) {
     sources.a = buffers.input(BufferPart::HalfA);
     sources.b = buffers.input(BufferPart::HalfB);
   }
-  if (halvesOfFull)
-    sources.full.halves = std::array<SubBuffer, 2>{sources.a.whole, sources.b.whole};
+  if (halvesOfFull) addHalvesOfFull(sources);
   buffers = {};
   return sources;
 }

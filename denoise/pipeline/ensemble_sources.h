@@ -17,13 +17,16 @@ struct EnsembleSources {
 
 // From K independent sub-buffers (K even): a = input(HalfA), b = input(HalfB), full =
 // input(Full). With K = 4 the half runs get quarters as their own halves; with K = 2 they get
-// none. Throws chorus::Error for an odd K.
-EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers);
+// none. Throws chorus::Error for an odd K. Without `halvesOfFull`, full.halves stays empty (no
+// member reads it: see readsHalves and baseRunsFor in ensemble.h; addHalvesOfFull adds it).
+EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers, bool halvesOfFull = true);
 
 // The same, taking the sub-buffers over (K = 2: they become a and b instead of being copied;
-// `buffers` is left empty). Without `halvesOfFull`, full.halves stays empty (for members that
-// never read it: see readsHalves in ensemble.h).
+// `buffers` is left empty).
 EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull);
+
+// full.halves = the half inputs' wholes (copies of every plane of both).
+void addHalvesOfFull(EnsembleSources& sources);
 
 // From an input with two halves (e.g. a Tungsten directory): a = halves[0], b = halves[1]
 // (without halves of their own), full = the input. Throws chorus::Error without halves.

@@ -159,13 +159,16 @@ void runRender(RenderArgs args) {
   // second copy of a large render in memory), and render.exr is on disk before denoising. A
   // preview writes no render.exr: its inputs take the buffers over.
   std::optional<EnsembleSources> sources;
-  if (denoise.enabled())
-    sources = args.preview
-                  ? sourcesFromBuffers(std::move(result.buffers), readsHalves(denoise.members))
-                  : sourcesFromBuffers(result.buffers);
-  // With the quarters estimate nothing runs on the full buffer: its halves (two copies of every
-  // plane, 1.5 GB at 4K) are not kept through the members' runs.
-  if (sources && !baseRunsFor(denoise.options.mse, *sources).full) sources->full.halves.reset();
+  if (denoise.enabled()) {
+    sources = args.preview ? sourcesFromBuffers(std::move(result.buffers), false)
+                           : sourcesFromBuffers(result.buffers, false);
+    // The full buffer's halves (two copies of every plane, 1.5 GB at 4K) only for a run on the
+    // full buffer (none with the quarters estimate), and in a preview only for members that
+    // read them.
+    if (baseRunsFor(denoise.options.mse, *sources).full &&
+        (!args.preview || readsHalves(denoise.members)))
+      addHalvesOfFull(*sources);
+  }
   const Stopwatch write;
   if (!args.preview) {
     const std::vector<ExrLayer> layers = sampleBuffersToLayers(std::move(result.buffers));

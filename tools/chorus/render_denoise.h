@@ -19,7 +19,8 @@ namespace chorus::cli {
 // The members `chorus render` uses when --denoise is not given, and with --preview (README,
 // "Choosing the default members": the sweep evidence behind both).
 inline constexpr const char* kDefaultDenoise = "nfor,rdfc,atrous";
-inline constexpr const char* kPreviewDenoise = "atrous,atrous:iterations=4:sigmaL=8:sigmaN=16";
+inline constexpr const char* kPreviewDenoise =
+    "atrous:borrow=0.5,atrous:iterations=4:sigmaL=8:sigmaN=16:borrow=0.5";
 
 // The ensemble options previews change, each unless its flag was given: no weight filter (it
 // cost more than it gained at 4 spp) and no image prior (the two à-trous members differ by

@@ -27,12 +27,14 @@ AtrousParams AtrousParams::fromParams(ParamMap& params) {
   p.demodulate = params.getBool("demodulate", p.demodulate);
   p.clampFireflies = params.getBool("clampFireflies", p.clampFireflies);
   p.symmetricFrom = params.getFloat("symmetricFrom", p.symmetricFrom);
+  p.borrow = params.getFloat("borrow", p.borrow);
   if (p.iterations < kIterationsFromSamples || p.iterations > kMaxIterations)
     throw Error("atrous: iterations must be in [0, " + std::to_string(kMaxIterations) +
                 "], or -1 (from the samples per pixel)");
   if (!(p.sigmaZ > 0) || !std::isfinite(p.sigmaZ)) throw Error("atrous: sigmaZ must be > 0");
   if (!(p.sigmaL > 0) || !std::isfinite(p.sigmaL)) throw Error("atrous: sigmaL must be > 0");
   if (!(p.symmetricFrom >= 0)) throw Error("atrous: symmetricFrom must be >= 0");
+  if (!(p.borrow >= 0 && p.borrow <= 1)) throw Error("atrous: borrow must be in [0, 1]");
   // Powers of two only: w_n is then a chain of squarings, which vectorises.
   if (p.sigmaN != 0 && !(p.sigmaN >= 1 && p.sigmaN <= 1024 && p.sigmaN == std::floor(p.sigmaN) &&
                          std::has_single_bit(unsigned(p.sigmaN))))
@@ -172,11 +174,12 @@ using StatisticsLanes = Float4;
 using StatisticsLanes = Float1;
 #endif
 
-// Luminance of rows [first, last) and their inverse tolerance 1 / (σ_l √(g3×3 ∗ Var) + ε_l),
-// with the 3×3 Gaussian (1/4 centre, 1/8 edges, 1/16 corners) clipped and renormalised at the
-// borders, applied separably ([1 2 1] / 4 per axis, / 3 where one side is missing, / 2 with
-// none). Each row is smoothed horizontally once, into a ring of three rows.
-void levelStatistics(const PaddedPlanes& state, float sigmaL, int first, int last,
+// Luminance of rows [first, last) and their inverse tolerance 1 / (σ_l √V + ε_l), with
+// V = max(borrow · B, min(Var, B)) and B = g3×3 ∗ Var (atrous.h; borrow 1: V = B), the 3×3
+// Gaussian (1/4 centre, 1/8 edges, 1/16 corners) clipped and renormalised at the borders,
+// applied separably ([1 2 1] / 4 per axis, / 3 where one side is missing, / 2 with none). Each
+// row is smoothed horizontally once, into a ring of three rows.
+void levelStatistics(const PaddedPlanes& state, float sigmaL, float borrow, int first, int last,
                      PaddedPlanes& statistics) {
   const int w = state.width(), h = state.height();
   const float* variance = state.plane(kVariance);
@@ -204,6 +207,7 @@ void levelStatistics(const PaddedPlanes& state, float sigmaL, int first, int las
     const float yNorm = axisNorm(y, h);
     float* luminance = statistics.plane(0) + state.index(0, y);
     float* tolerance = statistics.plane(1) + state.index(0, y);
+    const float* ownVariance = variance + state.index(0, y);
     const float* color[3] = {state.plane(kRed) + state.index(0, y),
                              state.plane(kGreen) + state.index(0, y),
                              state.plane(kBlue) + state.index(0, y)};
@@ -214,9 +218,14 @@ void levelStatistics(const PaddedPlanes& state, float sigmaL, int first, int las
        F::broadcast(kLuminance[1]) * F::load(color[1] + x) +
        F::broadcast(kLuminance[2]) * F::load(color[2] + x))
           .store(luminance + x);
-      const F g = (F::load(ring[0] + x) + F::broadcast(2.0f) * F::load(ring[1] + x) +
-                   F::load(ring[2] + x)) *
-                  F::broadcast(yNorm);
+      F g = (F::load(ring[0] + x) + F::broadcast(2.0f) * F::load(ring[1] + x) +
+             F::load(ring[2] + x)) *
+            F::broadcast(yNorm);
+      if (borrow < 1) {
+        const F own = F::load(ownVariance + x), share = F::broadcast(borrow) * g;
+        const F lowered = g - max0(g - own);  // min(own, g)
+        g = share + max0(lowered - share);
+      }
       (F::broadcast(1.0f) / (F::broadcast(sigmaL) * sqrt(g) + F::broadcast(kLuminanceEpsilon)))
           .store(tolerance + x);
     };
@@ -235,7 +244,8 @@ void atrousLevel(const Guide& g, const AtrousParams& params, bool symmetric, Atr
                  const std::vector<float>& inside) {
   const int w = state.width(), h = state.height();
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
-    levelStatistics(state, params.sigmaL, rows.begin(), rows.end(), statistics);
+    levelStatistics(state, params.sigmaL, symmetric ? 1.0f : params.borrow, rows.begin(),
+                    rows.end(), statistics);
   });
 
   // Pointers to pixel (0, 0) of each plane (all planes share the padded layout).

@@ -25,7 +25,15 @@
 //     averages in the well-measured pixels around it, a bias that stays at any sample count
 //     (flight-helmet-studio 256 spp: 5.4× the noisy input). Below it the variances come from
 //     too few samples: a pixel whose few samples agree would veto every neighbour (Cornell
-//     box 4 spp: 0.024 → 0.062 relMSE with the rule on).
+//     box 4 spp: 0.024 → 0.062 relMSE with the rule on);
+//   - optionally (`borrow` < 1, below `symmetricFrom`; the previews' members), the variance in
+//     w_l is max(borrow · B, min(Var_l(p), B)) with B = g3×3 ∗ Var_l: lowered towards the
+//     pixel's own variance where that is smaller, by at most 1 / borrow. SVGF's blur gives a
+//     pixel whose few samples are all dark (a shadow line, the rim of a lit patch) its bright
+//     neighbours' variance, and with it a tolerance wide enough to take their light
+//     (interior-doorway 16 spp: relMSE 0.48, noisy 0.42; with borrow 0.5: 0.16). Off by default:
+//     better alone and in the preview, but the default ensemble blends worse with it at 4–8 spp
+//     (docs/members/sbf-atrous-bilateral.md).
 #include <string>
 
 #include "denoise/base/base_denoiser.h"
@@ -47,9 +55,12 @@ struct AtrousParams {
   // From this many samples per pixel of the render on, a tap's own tolerance counts too:
   // w_l uses the larger of p's and q's inverse tolerances (the stricter), docs/members/.
   float symmetricFrom = 32.0f;
+  // Below symmetricFrom, the least share of the 3×3-blurred variance a pixel's tolerance keeps
+  // where its own variance is smaller (1: SVGF's blurred variance alone, at any sample count).
+  float borrow = 1.0f;
 
   // Reads overrides: iterations, sigmaZ, sigmaN, sigmaL, demodulate, clampFireflies,
-  // symmetricFrom.
+  // symmetricFrom, borrow.
   // Throws chorus::Error for a value out of range.
   static AtrousParams fromParams(ParamMap& params);
 };

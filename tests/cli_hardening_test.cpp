@@ -75,6 +75,7 @@ const std::vector<BadFlag> kBadRenderFlags = {
     {"--seed", "1.5"},
     {"--seed", "0x10"},
     {"--out", ""},
+    {"--out", "--image-prior=1,2"},
     {"--width", "100000"},
     {"--width", "0"},
     {"--width", "-5"},
@@ -101,6 +102,7 @@ const std::vector<BadFlag> kBadRenderFlags = {
     {"--background", "1,nan,1"},
     {"--background", "1e7"},
     {"--env", ""},
+    {"--env", "--spp"},
     {"--reference", ""},
     {"--splits", "3"},
     {"--tracer", "fast"},
@@ -140,6 +142,7 @@ TEST(CliHardening, EveryBadSweepAndDenoiseFlagIsOneLineNamingIt) {
   args.insert(args.end(), {"--spp", "4,16777217"});
   expectRefused(args, "--spp '4,16777217': 16777217 is above 16777216", out);
   for (const BadFlag& bad : std::vector<BadFlag>{{"--out", ""},
+                                                 {"--out", "--image-prior=1,2"},
                                                  {"--window", "1000000"},
                                                  {"--noisy-fallback", "nan"},
                                                  {"--keep", "render"}})

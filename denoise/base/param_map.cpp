@@ -17,7 +17,10 @@ ParamMap ParamMap::parse(const std::string& text, const std::string& context) {
     const size_t eq = item.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
       throw Error(context + ": parameter '" + item + "' is not of the form key=value");
-    params.set(item.substr(0, eq), item.substr(eq + 1));
+    const std::string key = item.substr(0, eq);
+    // Given twice, one value would silently win (`alpha=nan:alpha=4` passed the finite check).
+    if (params.has(key)) throw Error(context + ": parameter " + key + " is given twice");
+    params.set(key, item.substr(eq + 1));
   }
   return params;
 }

@@ -3,6 +3,8 @@
 #include <climits>
 #include <cstdint>
 #include <cstring>
+#include <exception>
+#include <string>
 #include <vector>
 
 #include "common/error.h"
@@ -103,11 +105,20 @@ void readModel(const std::filesystem::path& path, tinygltf::Model* model) {
   std::string err, warn;
   const std::string baseDir = path.parent_path().string();
   const auto size = static_cast<unsigned int>(bytes.size());
-  const bool ok =
-      hasGlbMagic(bytes)
-          ? loader.LoadBinaryFromMemory(model, &err, &warn, bytes.data(), size, baseDir)
-          : loader.LoadASCIIFromString(model, &err, &warn,
-                                       reinterpret_cast<const char*>(bytes.data()), size, baseDir);
+  bool ok = false;
+  try {
+    ok = hasGlbMagic(bytes)
+             ? loader.LoadBinaryFromMemory(model, &err, &warn, bytes.data(), size, baseDir)
+             : loader.LoadASCIIFromString(
+                   model, &err, &warn, reinterpret_cast<const char*>(bytes.data()), size, baseDir);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    // tinygltf itself throws on some malformed files (a .glb whose buffer 0 has byteLength 0:
+    // std::out_of_range from its own bounds-checked access).
+    throw fileError(path, std::string("not a readable glTF file: the parser stopped (") +
+                              firstLine(e.what()) + ")");
+  }
   if (!ok) {
     // A refused buffer (images are optional to tinygltf: a refused one only goes missing).
     if (!firstRefusal.empty() && err.find(firstRefusal) != std::string::npos)

@@ -332,7 +332,7 @@ const RegisterCommand denoiseCommand(40, [](CLI::App& app) {
                   "Comma-separated base denoisers: built-in specs (name or name:key=value) for a "
                   "render.exr or Tungsten directory, folder names for a directory of outputs")
       ->required();
-  cmd->add_option("--out", args->out, "Output directory")->required()->transform(nonEmpty());
+  cmd->add_option("--out", args->out, "Output directory")->required()->transform(pathName());
   cmd->add_option("--combine", args->combine,
                   "none (each method alone on the full buffer: DIR/<method>.exr/.png), or a "
                   "combiner or comma-separated list of them: ensemble, average, onehot-pre, "

@@ -80,10 +80,13 @@ CLI::Validator zeroOrFiniteIn(double lo, double hi) {
       "0 or " + range);
 }
 
-CLI::Validator nonEmpty() {
+CLI::Validator pathName() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        return text.empty() ? "must not be empty" : std::string();
+        if (text.empty()) return "must not be empty";
+        if (text.rfind("--", 0) == 0)
+          return "got '" + text + "', a flag where a file or directory name was expected";
+        return std::string();
       },
       "");
 }

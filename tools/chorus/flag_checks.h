@@ -18,8 +18,10 @@ CLI::Validator anyUnsigned64();
 CLI::Validator finiteIn(double lo, double hi);
 // 0 (off) or a finite number in [lo, hi].
 CLI::Validator zeroOrFiniteIn(double lo, double hi);
-// Anything but the empty string (an empty --out would write into the current directory).
-CLI::Validator nonEmpty();
+// A file or directory name: not empty (an empty --out would write into the current directory)
+// and not starting with "--" (`--out --image-prior=1` took the flag for a directory's name and
+// wrote there, leaving the flag unread).
+CLI::Validator pathName();
 
 // The ranges shared by several commands, each with the reason for its bound.
 // Image sides: 65536² pixels already need terabytes; the memory check (memory_estimate.h)

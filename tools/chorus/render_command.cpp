@@ -205,7 +205,7 @@ const RegisterCommand renderCommand(30, [](CLI::App& app) {
   cmd->add_option("scene", args->scene, "glTF scene (.gltf or .glb)")->required();
   cmd->add_option("--out", args->out, "Output directory")
       ->capture_default_str()
-      ->transform(nonEmpty());
+      ->transform(pathName());
   cmd->add_option("--spp", args->sceneOptions.render.spp,
                   "Samples per pixel (over all sub-buffers)")
       ->capture_default_str()
@@ -235,7 +235,7 @@ const RegisterCommand renderCommand(30, [](CLI::App& app) {
   cmd->add_option("--reference", args->reference,
                   "Reference image (.exr) of the same view: metrics of the noisy input, each "
                   "member and the result in stats.json")
-      ->transform(nonEmpty());
+      ->transform(pathName());
   args->ensemble.addFlags(*cmd);
   args->keep.addFlag(*cmd);
   cmd->add_flag("--quiet", args->quiet, "No progress bar or summary line");

@@ -75,7 +75,7 @@ void SceneOptions::addFlags(CLI::App& cmd) {
                                         "Constant environment radiance R,G,B (or one grey value)")
                              ->transform(radianceColour());
   auto* envFlag = cmd.add_option("--env", env, "Equirectangular environment map (.hdr or .exr)")
-                      ->transform(nonEmpty());
+                      ->transform(pathName());
   backgroundFlag->excludes(envFlag);
   cmd.add_option("--env-rotate", envRotate, "Rotate the environment about +Y, degrees")
       ->capture_default_str()

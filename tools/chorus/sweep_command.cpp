@@ -37,7 +37,7 @@ struct SweepArgs {
   std::string spp = "4,8,16,32,64,128,256", methods, combos = "all";
   std::string combiners = "ensemble,onehot-pre,onehot-post,average,oracle";
   std::string out, shard = "0/1";
-  int referenceSpp = 16384;
+  int referenceSpp = sweep::kDefaultReferenceSpp;
   double referenceSeconds = 0;
   int cropSize = 96;
   SceneOptions scene;
@@ -149,7 +149,7 @@ const RegisterCommand sweepCommand(50, [](CLI::App& app) {
   cmd->add_option("scenes", args->scenes, "glTF scenes (.gltf or .glb)");
   cmd->add_option("--out", args->out, "Output directory (reruns resume from it)")
       ->required()
-      ->transform(nonEmpty());
+      ->transform(pathName());
   cmd->add_option("--spp", args->spp, "Comma-separated samples per pixel")->capture_default_str();
   cmd->add_option("--methods", args->methods,
                   "Comma-separated base denoisers (default: every built-in one)");
@@ -164,7 +164,7 @@ const RegisterCommand sweepCommand(50, [](CLI::App& app) {
   cmd->add_option("--reference", args->references,
                   "Reference EXR, once per scene in scene order (default: rendered into "
                   "DIR/references/)")
-      ->transform(nonEmpty());
+      ->transform(pathName());
   cmd->add_option("--reference-spp", args->referenceSpp, "Samples per pixel of rendered references")
       ->capture_default_str()
       ->transform(integerIn(1, kMaxSpp));
@@ -177,7 +177,7 @@ const RegisterCommand sweepCommand(50, [](CLI::App& app) {
   cmd->add_option("--merge", args->merge,
                   "Combine the sweep directories of sharded runs into --out (no scenes)")
       ->expected(1, -1)
-      ->transform(nonEmpty());
+      ->transform(pathName());
   cmd->add_option("--crop-size", args->cropSize, "Side of the report's crops, pixels")
       ->capture_default_str()
       ->transform(integerIn(1, kMaxCropSize));

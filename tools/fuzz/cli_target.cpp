@@ -13,6 +13,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/image/exr_io.h"
+#include "tools/sweep/sweep_runner.h"
 
 namespace chorus::fuzz {
 namespace fs = std::filesystem;
@@ -89,7 +90,8 @@ const std::vector<std::string> kOutputs = {"{case}/out",  "{case}/out/a/b", "", 
                                            "{case}/file", "{case}/out/",    "out"};
 const std::map<std::string, std::vector<std::string>> kDenoiserKeys = {
     {"atrous",
-     {"iterations", "sigmaL", "sigmaN", "sigmaZ", "demodulate", "clampFireflies", "symmetricFrom"}},
+     {"iterations", "sigmaL", "sigmaN", "sigmaZ", "demodulate", "clampFireflies", "symmetricFrom",
+      "borrow"}},
     {"nfor", {"regressionR", "finalR", "finalK", "epsilon", "mseR", "prefilterK"}},
     {"nlm", {"r", "f", "k", "alpha", "weightThreshold"}},
     {"sbf", {"sigmaS", "sigmaR", "sigmaN", "sigmaMse"}},
@@ -257,7 +259,20 @@ bool inRange(const std::string& type, std::string value) {
 
 bool asksForHugeWork(const std::vector<std::string>& args) {
   static const std::regex number(R"([-+]?[0-9.]+(e[+-]?[0-9]+)?)", std::regex::icase);
-  for (const auto& [flag, value] : flagValues(args)) {
+  // A sweep renders its references at 16384 spp unless told otherwise: an 8 × 65536 sweep is
+  // 8.6e9 reference samples without any value of 1e5.
+  double width = 0, height = 0;
+  bool referenceSet = false;
+  const auto values = flagValues(args);
+  for (const auto& [flag, value] : values) {
+    if (flag == "--width") width = std::strtod(value.c_str(), nullptr);
+    if (flag == "--height") height = std::strtod(value.c_str(), nullptr);
+    referenceSet = referenceSet || flag == "--reference-spp" || flag == "--reference-seconds";
+  }
+  if (!args.empty() && args[0] == "sweep" && !referenceSet &&
+      width * height * sweep::kDefaultReferenceSpp >= 1e9)
+    return true;
+  for (const auto& [flag, value] : values) {
     if (!isWorkFlag(flag)) continue;
     for (auto it = std::sregex_iterator(value.begin(), value.end(), number);
          it != std::sregex_iterator(); ++it) {

@@ -19,6 +19,9 @@
 
 namespace chorus::sweep {
 
+// Samples per pixel of a rendered reference unless the sweep is given another count or a time.
+inline constexpr int kDefaultReferenceSpp = 16384;
+
 struct SweepConfig {
   std::vector<std::filesystem::path> scenes;
   std::vector<int> spps = {4, 8, 16, 32, 64, 128, 256};
@@ -28,7 +31,7 @@ struct SweepConfig {
                                         "oracle"};
   // Reference images, one per scene in scene order (empty: render them into DIR/references/).
   std::vector<std::filesystem::path> references;
-  int referenceSpp = 16384;
+  int referenceSpp = kDefaultReferenceSpp;
   double referenceSeconds = 0;  // > 0: a time budget instead of referenceSpp (see runSweep)
   std::filesystem::path out;
   Shard shard;

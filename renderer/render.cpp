@@ -32,6 +32,10 @@ void validate(const RenderOptions& o) {
   checkThreadCount(o.threads);
   if (o.camera < 0) throw Error("--camera must be 0 or more");
   if (o.rouletteStartDepth < 0) throw Error("--roulette-depth must be 0 or more");
+  if (!(o.lensRadius >= 0) || !std::isfinite(o.lensRadius))
+    throw Error("--lens-radius must be a finite number >= 0");
+  if (!(o.focusDistance >= 0) || !std::isfinite(o.focusDistance))
+    throw Error("--focus-distance must be a finite number >= 0");
 }
 
 }  // namespace
@@ -45,15 +49,37 @@ Resolution renderResolution(const Scene& scene, const RenderOptions& options) {
   return chooseResolution(fileCamera ? *fileCamera : CameraDesc{}, options.width, options.height);
 }
 
+CameraDesc focusCamera(const Scene& scene, const RenderOptions& options) {
+  const Resolution resolution = renderResolution(scene, options);
+  CameraDesc desc =
+      selectCamera(scene, options.camera, float(resolution.width) / float(resolution.height));
+  desc.lensRadius = options.lensRadius;
+  desc.focusDistance = options.focusDistance;
+  if (desc.lensRadius > 0 && desc.focusDistance == 0) {
+    // Autofocus: the depth along the axis of what the centre pixel's pinhole ray sees.
+    CameraDesc pinhole = desc;
+    pinhole.lensRadius = 0;
+    const Ray centre =
+        Camera(pinhole, resolution)
+            .generateRay({0.5f * float(resolution.width), 0.5f * float(resolution.height)});
+    Hit hit;
+    const float depth = scene.intersect(centre, &hit)
+                            ? hit.t * dot(centre.direction, desc.forward)
+                            : dot(scene.bounds().center() - desc.position, desc.forward);
+    if (!(depth > 0) || !std::isfinite(depth))
+      throw Error("cannot autofocus: nothing in front of the camera; give --focus-distance");
+    desc.focusDistance = depth;
+  }
+  return desc;
+}
+
 RenderResult render(const Scene& scene, const RenderOptions& options,
                     const ProgressCallback& progress) {
   validate(options);
   const Stopwatch elapsed;
 
   const Resolution resolution = renderResolution(scene, options);
-  const Camera camera(
-      selectCamera(scene, options.camera, float(resolution.width) / float(resolution.height)),
-      resolution);
+  const Camera camera(focusCamera(scene, options), resolution);
   const LightSet lights(scene);
   const PathTracerSettings settings{options.maxDepth, options.rouletteStartDepth};
   const PathTracer tracer(scene, lights, settings);

@@ -32,6 +32,10 @@ struct RenderOptions {
   // with renderers that trace every path to full length).
   int rouletteStartDepth = 3;
   int camera = 0;  // index into the scene's cameras (0 with none: frame the bounds)
+  // Depth of field (glTF cameras have none): the thin lens's radius in world units (0: a
+  // pinhole) and the distance along the view axis that is in focus (0: autofocus, the distance
+  // to the surface under the image centre; see focusCamera).
+  float lensRadius = 0, focusDistance = 0;
   // Which path tracer renders (the images are bit-identical; only the speed differs):
   // Automatic takes LaneTracer (four paths in SIMD lanes) when at least half the scene's surface
   // area has a material no texture varies, else PathTracer one path at a time.
@@ -73,6 +77,11 @@ struct RenderResult {
 // The image size render() gives `options` on `scene` (the width and height given, the rest from
 // the camera's aspect), for checks before rendering: memory, the size of a reference.
 Resolution renderResolution(const Scene& scene, const RenderOptions& options);
+
+// The camera render() uses: the scene's camera `options.camera` with the options' lens. With a
+// lens and focusDistance 0 it focuses on the surface under the image centre (along the axis),
+// or on the scene bounds' centre when that ray hits nothing.
+CameraDesc focusCamera(const Scene& scene, const RenderOptions& options);
 
 // Throws chorus::Error for invalid options (spp < 1, splits not 1/2/4, a missing camera, …).
 RenderResult render(const Scene& scene, const RenderOptions& options,

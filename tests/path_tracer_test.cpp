@@ -1,7 +1,8 @@
 // Light transport against analytic answers: white furnaces (Lambertian and glass spheres in a
 // uniform environment, an emissive enclosure's infinite series), a Lambertian sphere under an
 // environment map (quadrature over its texels), a Lambertian plane under a point light
-// (E·ρ/π with inverse-square falloff) and under a square area light (form factor).
+// (E·ρ/π with inverse-square falloff) and under a square area light (form factor), and a thin
+// lens's blur of an emitter's edge (the fraction of the lens disk that sees it).
 #include <gtest/gtest.h>
 
 #include <stb_image_write.h>
@@ -252,6 +253,52 @@ TEST(AnalyticLighting, LambertianPlaneUnderSquareAreaLight) {
       0.02);
   EXPECT_EQ(c.outliers, 0);
   EXPECT_LT(c.meanRelativeError, 0.005);
+}
+
+// A thin lens focused at 2 in front of an emitting half-plane at depth 4 (radiance 1, x < 0):
+// the image point s (image plane at distance 1) is lit by the lens points L on the unit disk
+// with s.x − L.x·k < 0, k = R·(1/2 − 1/4) (the circle of confusion: camera.h), i.e. the part of
+// the disk beyond a = s.x / k, of area acos(a) − a·√(1 − a²); each pixel averages it over its
+// width. The pinhole render of the same edge is a step.
+TEST(AnalyticLighting, ThinLensBlursAnEdgeByItsCircleOfConfusion) {
+  GltfBuilder b;
+  json emitter = test::lambertianMaterial(0, 0, 0);
+  emitter["emissiveFactor"] = {1, 1, 1};
+  b.addQuad({-10, -10, -4}, {0, -10, -4}, {0, 10, -4}, {-10, 10, -4}, b.addMaterial(emitter));
+  const int cam =
+      b.addCamera({{"type", "perspective"}, {"perspective", {{"yfov", kPi / 2}, {"znear", 0.01}}}});
+  b.addNode({{"camera", cam}});
+  const int n = 48;  // 24 pixels per unit of the image plane (tan 45° = 1)
+  RenderOptions o = options(n, 64);
+  const auto columns = [&](const RenderResult& r) {
+    std::vector<double> mean(size_t(n), 0.0);
+    const SubBuffer& full = r.buffers.part(BufferPart::Full);
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) mean[size_t(x)] += full.color.mean.at(x, y, 0) / n;
+    return mean;
+  };
+  const std::vector<double> sharp = columns(renderGltf(b, EnvironmentDesc{}, o));
+  EXPECT_NEAR(sharp[23], 1.0, 1e-6);
+  EXPECT_NEAR(sharp[24], 0.0, 1e-6);
+  o.lensRadius = 0.5f;
+  o.focusDistance = 2.0f;
+  const std::vector<double> blurred = columns(renderGltf(b, EnvironmentDesc{}, o));
+  const double k = 0.5 * (1.0 / 2 - 1.0 / 4);  // 3 pixels
+  const auto litShare = [&](double sx) {
+    const double a = std::clamp(sx / k, -1.0, 1.0);
+    return (std::acos(a) - a * std::sqrt(1 - a * a)) / kPi;
+  };
+  for (int x = 16; x < 32; ++x) {
+    double expected = 0;
+    const int steps = 200;
+    for (int i = 0; i < steps; ++i)
+      expected += litShare((x - 24 + (i + 0.5) / steps) / 24.0) / steps;
+    EXPECT_NEAR(blurred[size_t(x)], expected, 0.02) << "column " << x;
+  }
+  // The blur spans three pixels each side of the edge and no more.
+  EXPECT_LT(blurred[22], 0.9);
+  EXPECT_NEAR(blurred[19], 1.0, 1e-6);
+  EXPECT_NEAR(blurred[29], 0.0, 1e-6);
 }
 
 double correlation(const std::vector<double>& a, const std::vector<double>& b) {

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "common/error.h"
+#include "renderer/sampling/warps.h"
 
 namespace chorus::render {
 
@@ -59,17 +60,37 @@ Camera::Camera(const CameraDesc& desc, Resolution resolution)
     halfHeight_ = desc.ymag;
   }
   halfWidth_ = halfHeight_ * aspect;
+  if (!(desc.lensRadius >= 0) || !std::isfinite(desc.lensRadius))
+    throw Error("the lens radius must be a finite number >= 0");
+  if (desc.lensRadius > 0) {
+    if (desc.projection != ProjectionType::Perspective)
+      throw Error("depth of field needs a perspective camera (camera '" + desc.name +
+                  "' is orthographic)");
+    if (!(desc.focusDistance > 0) || !std::isfinite(desc.focusDistance))
+      throw Error("the focus distance must be a finite number > 0");
+  }
 }
 
-Ray Camera::generateRay(Vec2f pRaster) const {
+Ray Camera::generateRay(Vec2f pRaster, Vec2f uLens) const {
   // Normalised device coordinates in [−1, 1], y up.
   const float ndcX = 2.0f * pRaster.x / float(resolution_.width) - 1.0f;
   const float ndcY = 1.0f - 2.0f * pRaster.y / float(resolution_.height);
   Ray ray;
   if (desc_.projection == ProjectionType::Perspective) {
+    // The pinhole direction with unit length along the axis: it reaches the plane in focus at
+    // focusDistance times itself.
+    const Vec3f axial =
+        desc_.forward + desc_.right * (ndcX * halfWidth_) + desc_.up * (ndcY * halfHeight_);
     ray.origin = desc_.position;
-    ray.direction = normalize(desc_.forward + desc_.right * (ndcX * halfWidth_) +
-                              desc_.up * (ndcY * halfHeight_));
+    if (thinLens()) {
+      const Vec2f disk = sampleConcentricDisk(uLens);
+      const Vec3f onLens =
+          desc_.right * (disk.x * desc_.lensRadius) + desc_.up * (disk.y * desc_.lensRadius);
+      ray.origin = desc_.position + onLens;
+      ray.direction = normalize(axial * desc_.focusDistance - onLens);
+    } else {
+      ray.direction = normalize(axial);
+    }
   } else {
     ray.origin =
         desc_.position + desc_.right * (ndcX * halfWidth_) + desc_.up * (ndcY * halfHeight_);

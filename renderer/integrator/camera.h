@@ -1,6 +1,7 @@
 #pragma once
-// Pinhole perspective and orthographic cameras from glTF camera nodes, the image resolution
-// they imply, and a default camera framing the scene's bounds when the file has none.
+// Pinhole perspective and orthographic cameras from glTF camera nodes, optionally with a thin
+// lens (depth of field), the image resolution they imply, and a default camera framing the
+// scene's bounds when the file has none.
 #include <optional>
 
 #include "renderer/scene/scene.h"
@@ -29,12 +30,21 @@ CameraDesc selectCamera(const Scene& scene, int index, float aspect);
 class Camera {
  public:
   // The image aspect (width / height) overrides the camera's own: perspective keeps yfov,
-  // orthographic keeps ymag.
+  // orthographic keeps ymag. Throws chorus::Error for a lens radius that is not finite and ≥ 0,
+  // a lens without a finite focus distance > 0, or a lens on an orthographic camera.
   Camera(const CameraDesc& desc, Resolution resolution);
 
   // The ray through raster position pRaster (x right, y down, in pixels; pixel (i, j) covers
-  // [i, i+1) × [j, j+1)). Directions are unit length.
-  Ray generateRay(Vec2f pRaster) const;
+  // [i, i+1) × [j, j+1)). Directions are unit length. With a thin lens, uLens ∈ [0,1)² picks the
+  // point on the lens disk (concentric mapping) and the ray passes through the point the pinhole
+  // ray reaches on the plane in focus, so that plane stays sharp: a point at distance z along
+  // the axis is spread over a disk of radius lensRadius·|1/focusDistance − 1/z| on the image
+  // plane at distance 1. Perspective cameras only (the constructor refuses an orthographic one
+  // with a lens). Without a lens uLens is ignored.
+  Ray generateRay(Vec2f pRaster, Vec2f uLens = {}) const;
+  // Whether rays need a lens sample (the sampler draws one only then, so that pinhole renders
+  // keep their sample dimensions).
+  bool thinLens() const { return desc_.lensRadius > 0; }
 
   const CameraDesc& desc() const { return desc_; }
   Resolution resolution() const { return resolution_; }

@@ -29,7 +29,10 @@ struct FeatureRecorder {
 Ray startPixelSample(Sampler& sampler, const Camera& camera, int x, int y, int sample, int splits) {
   sampler.startPixelSample(x, y, uint32_t(sample / splits), sample % splits);
   const Vec2f offset = sampler.getPixel2D();
-  return camera.generateRay({float(x) + offset.x, float(y) + offset.y});
+  // The lens sample follows the film position; pinhole renders draw none, so their dimensions
+  // (and images) are what they were before cameras had lenses.
+  const Vec2f lens = camera.thinLens() ? sampler.get2D() : Vec2f{};
+  return camera.generateRay({float(x) + offset.x, float(y) + offset.y}, lens);
 }
 
 Rgb volumeTransmittance(const MaterialDesc& m, float distance) {

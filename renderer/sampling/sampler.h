@@ -6,7 +6,8 @@
 //
 // Usage (pbrt-v4 style): startPixelSample(), then get1D()/get2D()/getPixel2D() in a fixed
 // order; each call advances an internal dimension counter. Dimension order used by the
-// integrator: getPixel2D (film position), then per bounce: get1D (lobe), get2D (BSDF direction),
+// integrator: getPixel2D (film position), get2D (lens position: thin-lens cameras only), then
+// per bounce: get1D (lobe), get2D (BSDF direction),
 // get1D (light choice), get2D (light position), get1D (Russian roulette).
 #include <cstdint>
 

@@ -145,6 +145,10 @@ struct CameraDesc {
   // Camera frame in world space (a glTF camera looks down its local −Z with +Y up), orthonormal.
   Vec3f position;
   Vec3f forward{0, 0, -1}, up{0, 1, 0}, right{1, 0, 0};
+  // Thin lens (depth of field): radius of the lens disk in world units (0: a pinhole) and the
+  // distance along `forward` of the plane in focus. glTF has no aperture: these come from the
+  // render options (--lens-radius, --focus-distance).
+  float lensRadius = 0.0f, focusDistance = 0.0f;
 };
 
 // The whole parsed scene.

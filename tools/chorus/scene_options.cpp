@@ -18,6 +18,8 @@ namespace {
 
 // Far beyond the cameras of any scene; the index only has to stay an int.
 constexpr int64_t kMaxCameraIndex = 1'000'000;
+// Lens radii and focus distances: far beyond any scene's size (float keeps ~7 digits there).
+constexpr double kMaxSceneLength = 1e12;
 
 // --background: parseRgb's R,G,B (or grey) with non-negative components, each at most
 // kMaxRadianceScale.
@@ -71,6 +73,15 @@ void SceneOptions::addFlags(CLI::App& cmd) {
   cmd.add_option("--camera", render.camera, "Camera index (glTF camera nodes in order)")
       ->capture_default_str()
       ->transform(integerIn(0, kMaxCameraIndex));
+  cmd.add_option("--lens-radius", render.lensRadius,
+                 "Depth of field: radius of the thin lens in scene units (0: a pinhole)")
+      ->capture_default_str()
+      ->transform(finiteIn(0, kMaxSceneLength));
+  cmd.add_option("--focus-distance", render.focusDistance,
+                 "Distance along the view axis that is in focus, scene units (0: autofocus on "
+                 "the surface under the image centre)")
+      ->capture_default_str()
+      ->transform(finiteIn(0, kMaxSceneLength));
   auto* backgroundFlag = cmd.add_option("--background", background,
                                         "Constant environment radiance R,G,B (or one grey value)")
                              ->transform(radianceColour());

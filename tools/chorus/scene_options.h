@@ -16,8 +16,8 @@ struct SceneOptions {
   std::string background, env;
   float envRotate = 0, envIntensity = 1;
 
-  // Adds --width --height --seed --threads --max-depth --camera --background --env
-  // --env-rotate --env-intensity to `cmd`.
+  // Adds --width --height --seed --threads --max-depth --camera --lens-radius --focus-distance
+  // --background --env --env-rotate --env-intensity to `cmd`.
   void addFlags(CLI::App& cmd);
   render::EnvironmentDesc environment() const;
   // "default white (no lights in scene)", the --env file, "constant R,G,B" or "none".

@@ -87,6 +87,8 @@ std::string sweepSettings(const SweepConfig& config) {
        << "\nenvironment " << int(e.kind) << " " << e.radiance.r << "," << e.radiance.g << ","
        << e.radiance.b << " " << e.source << " " << e.rotationDegrees << " " << e.intensity
        << "\nreference";
+  // Pinhole sweeps keep the settings they had before cameras had lenses (their folders resume).
+  if (r.lensRadius > 0) text << "\nlens " << r.lensRadius << " focus " << r.focusDistance;
   for (const fs::path& file : config.references) text << " " << file.string();
   if (config.references.empty())
     text << " spp " << config.referenceSpp << " seconds " << config.referenceSeconds;

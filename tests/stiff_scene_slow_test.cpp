@@ -1,11 +1,15 @@
 // The stiff rendered scene (scenes/stiff-caustics.gltf: a tiny emitter sealed in a glass ball,
 // so that everything it lights is found by rare caustic paths, samples thousands of times the
-// mean) at 64×64 and 4, 16 and 64 spp (K = 4), against a 4096-spp reference rendered here with
-// its own seed. Every registered member, run alone on the full buffer, must beat the noisy
-// input; every run (alone, and the held-out runs the ensemble blends) writes finite,
-// non-negative values; the ensemble of all of them must stay within 1.1× of its best member at
-// 16 and 64 spp and within 1.3× at 4 spp (measured on 2026-12-05: 0.92×, 0.99× and 1.07×).
-// docs/outliers.md has the figures at 128×128 against a 2048-spp reference.
+// mean) as issue 26 first met it: with depth of field (a lens of radius 8 cm focused on the gold
+// sphere, 1.6 m away: the wall, the floor and the clear sphere are defocused, their features
+// blurred) and an environment (a constant sky, radiance 0.3), at 64×64 and 4, 16 and 64 spp
+// (K = 4), against a 4096-spp reference rendered here with its own seed. Every registered member,
+// run alone on the full buffer, must beat the noisy input; every run (alone, and the held-out runs
+// the ensemble blends) writes finite, non-negative values; the ensemble of all of them must stay
+// within 1.1× of its best member (measured on 2026-12-05: 0.98×, 1.04× and 0.90× at 4, 16 and 64
+// spp; before the lens and the sky, 1.3× was allowed at 4 spp; NFOR at 16 spp keeps one firefly
+// beside the bright ball, 69 % of its error). docs/outliers.md has the figures at 128×128 against
+// a 2048-spp reference.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -27,7 +31,7 @@ constexpr int kSize = 64;
 const render::Scene& stiffScene() {
   static const render::Scene scene =
       render::buildScene(render::loadGltf(test::sourceDir() / "scenes/stiff-caustics.gltf"),
-                         render::EnvironmentDesc{});
+                         render::EnvironmentDesc::constant(render::Rgb(0.3f)));
   return scene;
 }
 
@@ -37,6 +41,8 @@ SampleBuffers renderStiff(int spp, int splits, uint64_t seed) {
   options.spp = spp;
   options.splits = splits;
   options.seed = seed;
+  options.lensRadius = 0.08f;
+  options.focusDistance = 1.6f;
   return render::render(stiffScene(), options).buffers;
 }
 
@@ -75,7 +81,7 @@ TEST(StiffScene, MembersBeatTheNoisyInputAndTheEnsembleTracksTheBest) {
     const double combined = relMse(result.combined.image, reference);
     std::printf("  ensemble %.4g\n", combined);
     EXPECT_TRUE(finiteNonNegative(result.combined.image)) << spp << " spp";
-    EXPECT_LE(combined, (spp == 4 ? 1.3 : 1.1) * best) << spp << " spp";
+    EXPECT_LE(combined, 1.1 * best) << spp << " spp";
   }
 }
 

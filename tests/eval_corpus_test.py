@@ -155,6 +155,16 @@ class CorpusCommand(unittest.TestCase):
         for name in rendered:
             self.assertEqual(listed.count(name), 2, name)  # the sweep and the preview
 
+    def test_an_entry_with_a_lens_renders_through_it(self):
+        # The sweep and the preview sweep both get the lens, so that renders match references.
+        result = run(sys.executable, os.path.join(EVAL, "corpus.py"), "--dry-run", "--shared",
+                     shared_dir() or REPOSITORY, "--only", "glass-and-metal-dof,glass-and-metal")
+        commands = [line for line in result.stdout.splitlines() if not line.startswith("#")]
+        with_lens = [c for c in commands if "--lens-radius 0.08 --focus-distance 0" in c]
+        self.assertEqual(len(commands), 4, result.stdout)
+        self.assertEqual(len(with_lens), 2, result.stdout)
+        self.assertTrue(all("glass-and-metal-dof" in c for c in with_lens))
+
     def test_bad_flags_exit_2_with_one_line(self):
         for flags in (["--shard", "3/3"], ["--only", "no-such-entry"], ["--spp", "4,x"]):
             result = run(sys.executable, os.path.join(EVAL, "corpus.py"), "--dry-run", *flags)

@@ -33,11 +33,7 @@ BUILD = os.path.join(corpus_file.REPOSITORY, "build")
 
 def entry_args(entry, paths):
     """The scene and render flags of a rendered entry, as corpus.py gives them to the sweep."""
-    scene = paths.resolve(entry["scene"], entry["name"])
-    flags = ["--width", str(entry["width"])]
-    if entry.get("env"):
-        flags += ["--env", paths.resolve(entry["env"], entry["name"])]
-    return scene, flags
+    return paths.resolve(entry["scene"], entry["name"]), corpus.scene_flags(entry, paths)
 
 
 def run(command, quiet=False):

@@ -79,12 +79,21 @@ class Paths:
         raise corpus_file.CorpusError("%s: unknown path root in '%s'" % (flag_hint, reference))
 
 
+def scene_flags(entry, paths):
+    """The flags that make a rendered entry's image: its width, environment and lens (every
+    tool that renders an entry passes these, so that its renders match the references)."""
+    flags = ["--width", str(entry["width"])]
+    if entry.get("env"):
+        flags += ["--env", paths.resolve(entry["env"], entry["name"])]
+    if entry.get("lens"):
+        flags += ["--lens-radius", str(entry["lens"][0]), "--focus-distance", str(entry["lens"][1])]
+    return flags
+
+
 def sweep_commands(entry, corpus, paths, args, spps):
     """[(part, argv)] of a rendered entry: the sweep, then the preview sweep."""
     scene = paths.resolve(entry["scene"], entry["name"])
-    common = [scene, "--width", str(entry["width"]), "--threads", str(args.threads)]
-    if entry.get("env"):
-        common += ["--env", paths.resolve(entry["env"], entry["name"])]
+    common = [scene] + scene_flags(entry, paths) + ["--threads", str(args.threads)]
     out = os.path.join(paths.out, entry["name"])
     reference_spp = args.reference_spp or entry["reference_spp"]
     commands = [("sweep", [args.chorus, "sweep"] + common + [

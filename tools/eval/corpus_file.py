@@ -56,6 +56,10 @@ def load(path=DEFAULT_CORPUS):
                      label + ": width must be an integer in 16..4096")
             _require(isinstance(entry.get("reference_spp"), int) and entry["reference_spp"] > 0,
                      path, label + ": reference_spp must be a positive integer")
+            lens = entry.get("lens")
+            _require(lens is None or (isinstance(lens, list) and len(lens) == 2 and all(
+                isinstance(v, (int, float)) and v >= 0 for v in lens) and lens[0] > 0), path,
+                label + ": lens must be [radius > 0, focus distance >= 0 (0: autofocus)]")
             scene_key = entry["scene"]
         other = half_of_scene.setdefault(scene_key, entry["half"])
         _require(other == entry["half"], path,

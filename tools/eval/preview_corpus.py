@@ -12,7 +12,7 @@ import subprocess
 import sys
 
 import corpus_file
-from corpus import Paths
+from corpus import Paths, scene_flags
 
 
 def main():
@@ -35,11 +35,10 @@ def main():
         for seed in args.seeds.split(","):
             out = os.path.join(args.out, "%s-%s" % (entry["name"], seed))
             command = [args.chorus, "render", paths.resolve(entry["scene"], entry["name"]),
-                       "--preview", "--width", str(entry["width"]), "--seed", seed,
+                       "--preview", "--seed", seed,
                        "--reference", os.path.join(args.cache, entry["name"], "reference.exr"),
-                       "--out", out, "--quiet", "--threads", "2"] + args.flags
-            if entry.get("env"):
-                command += ["--env", paths.resolve(entry["env"], entry["name"])]
+                       "--out", out, "--quiet", "--threads", "2"] + scene_flags(entry, paths) + \
+                args.flags
             subprocess.run(command, check=True, stderr=subprocess.DEVNULL)
             metrics = json.load(open(os.path.join(out, "stats.json")))["metrics"]
             members = [v for k, v in metrics.items() if k not in ("noisy", "denoised")]

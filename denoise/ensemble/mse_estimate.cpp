@@ -1,5 +1,6 @@
 #include "denoise/ensemble/mse_estimate.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -180,6 +181,14 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
     windowGuides_.normal = finitePlanes(guides.normal);
     windowGuides_.albedo = finitePlanes(guides.albedo);
   }
+  // Every pass over the image asks which bases are finite at a pixel (the masks, the terms with
+  // their window's halo, the prior): once per pixel here instead of four times there.
+  validity_.resize(size_t(width_) * size_t(height_));
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, validity_.size()),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      for (size_t p = range.begin(); p < range.end(); ++p)
+                        validity_[p] = computeValidAt(p);
+                    });
   if (options.imagePrior > 0 && !reference_) imagePrior_ = imagePriorTerms();
 }
 
@@ -259,6 +268,10 @@ double MseEstimator::objectiveEpsilon() const {
 }
 
 BaseMask MseEstimator::validAt(size_t pixel) const {
+  return validity_[pixel];
+}
+
+BaseMask MseEstimator::computeValidAt(size_t pixel) const {
   BaseMask mask = 0;
   const size_t e = pixel * 3;
   for (int i = 0; i < baseCount_; ++i) {

@@ -203,6 +203,7 @@ class MseEstimator {
   std::vector<BaseMask> pixelTerms(int y0, int y1, std::vector<float>& planes,
                                    double relativeEpsilon) const;
   double objectiveEpsilon() const;
+  BaseMask computeValidAt(size_t pixel) const;  // what validAt returns, from the images
   // The mean of the relative per-pixel terms, each entry over the pixels where both its bases
   // are present (empty when no pixel has any); addImagePrior scales it per pixel.
   std::vector<double> imagePriorTerms() const;
@@ -257,6 +258,7 @@ class MseEstimator {
   double primaryWeight_ = 1.0, secondaryWeight_ = 0.0;
   const float* reference_ = nullptr;  // oracle only
   std::vector<double> imagePrior_;    // imagePriorTerms() (empty: no prior)
+  std::vector<BaseMask> validity_;    // validAt per pixel
   PlanarGuides windowGuides_;
   BilateralKernel windowKernel_;
 };

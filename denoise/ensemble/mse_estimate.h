@@ -207,6 +207,9 @@ class MseEstimator {
   // The mean of the relative per-pixel terms, each entry over the pixels where both its bases
   // are present (empty when no pixel has any); addImagePrior scales it per pixel.
   std::vector<double> imagePriorTerms() const;
+  // Adds row y's relative per-pixel terms to the prior's sums and their pixel counts.
+  void addPriorRow(int y, std::vector<float>& planes, std::vector<double>& sum,
+                   std::vector<size_t>& count) const;
   // H += imagePrior · (tangent trace of H) · imagePrior_, per pixel of `rows`.
   void addImagePrior(MseRows& rows) const;
   // One fold of the estimate: every base's run that did not see `comparator`, the noisy mean

@@ -55,6 +55,10 @@ CameraDesc focusCamera(const Scene& scene, const RenderOptions& options) {
       selectCamera(scene, options.camera, float(resolution.width) / float(resolution.height));
   desc.lensRadius = options.lensRadius;
   desc.focusDistance = options.focusDistance;
+  if (desc.lensRadius > 0 && desc.projection != ProjectionType::Perspective)
+    throw fileError(scene.data().source, "camera '" + desc.name +
+                                             "' is orthographic: depth of field (--lens-radius) "
+                                             "needs a perspective camera");
   if (desc.lensRadius > 0 && desc.focusDistance == 0) {
     // Autofocus: the depth along the axis of what the centre pixel's pinhole ray sees.
     CameraDesc pinhole = desc;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "common/error.h"
 #include "renderer/render.h"
 #include "renderer/scene/gltf_loader.h"
 #include "tests/support/gltf_builder.h"
@@ -299,6 +300,19 @@ TEST(AnalyticLighting, ThinLensBlursAnEdgeByItsCircleOfConfusion) {
   EXPECT_LT(blurred[22], 0.9);
   EXPECT_NEAR(blurred[19], 1.0, 1e-6);
   EXPECT_NEAR(blurred[29], 0.0, 1e-6);
+  // An orthographic camera has no lens: one error naming the scene file.
+  addTopDownCamera(b, 5, 1);
+  o.camera = 1;
+  test::TempDir dir;
+  b.writeGltf(dir / "ortho.gltf");
+  const Scene ortho = buildScene(loadGltf(dir / "ortho.gltf"), EnvironmentDesc{});
+  try {
+    render(ortho, o);
+    ADD_FAILURE() << "a lens on an orthographic camera rendered";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("ortho.gltf"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("orthographic"), std::string::npos) << e.what();
+  }
 }
 
 double correlation(const std::vector<double>& a, const std::vector<double>& b) {

@@ -136,7 +136,8 @@ void runRender(RenderArgs args) {
   const Resolution size = renderResolution(loaded.scene, options);
   if (reference) checkReferenceSize(*reference, args.reference, size.width, size.height);
   checkRunMemory(size, options.splits, denoise.members);
-  OwnedDirectory out(args.out);  // held until every file is written
+  focusCamera(loaded.scene, options);  // a lens its camera cannot take, nothing to focus on
+  OwnedDirectory out(args.out);        // held until every file is written
 
   ProgressBar bar(!args.quiet && ProgressBar::stderrIsTerminal());
   RenderResult result =

@@ -55,10 +55,6 @@ CameraDesc focusCamera(const Scene& scene, const RenderOptions& options) {
       selectCamera(scene, options.camera, float(resolution.width) / float(resolution.height));
   desc.lensRadius = options.lensRadius;
   desc.focusDistance = options.focusDistance;
-  if (desc.lensRadius > 0 && desc.projection != ProjectionType::Perspective)
-    throw fileError(scene.data().source, "camera '" + desc.name +
-                                             "' is orthographic: depth of field (--lens-radius) "
-                                             "needs a perspective camera");
   if (desc.lensRadius > 0 && desc.focusDistance == 0) {
     // Autofocus: the depth along the axis of what the centre pixel's pinhole ray sees.
     CameraDesc pinhole = desc;
@@ -74,6 +70,12 @@ CameraDesc focusCamera(const Scene& scene, const RenderOptions& options) {
       throw Error("cannot autofocus: nothing in front of the camera; give --focus-distance");
     desc.focusDistance = depth;
   }
+  // The camera's own checks (a lens on an orthographic camera), naming the scene.
+  try {
+    Camera(desc, resolution);
+  } catch (const Error& e) {
+    throw fileError(scene.data().source, e.what());
+  }
   return desc;
 }
 
@@ -83,7 +85,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
   const Stopwatch elapsed;
 
   const Resolution resolution = renderResolution(scene, options);
-  const Camera camera(focusCamera(scene, options), resolution);
+  const CameraDesc cameraDesc = focusCamera(scene, options);
+  const Camera camera(cameraDesc, resolution);
   const LightSet lights(scene);
   const PathTracerSettings settings{options.maxDepth, options.rouletteStartDepth};
   const PathTracer tracer(scene, lights, settings);
@@ -161,6 +164,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
   s.nanSamplesDropped = dropped;
   s.triangles = scene.data().triangleCount;
   s.lanes = laneTracer.has_value();
+  s.focusDistance = camera.thinLens() ? cameraDesc.focusDistance : 0.0f;
   return result;
 }
 

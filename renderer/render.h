@@ -54,7 +54,8 @@ struct RenderStats {
   uint64_t shadowRays = 0;         // of which shadow rays
   uint64_t nanSamplesDropped = 0;  // samples with a non-finite value, not accumulated
   size_t triangles = 0;
-  bool lanes = false;  // traced by LaneTracer (four paths in SIMD lanes), else by PathTracer
+  bool lanes = false;       // traced by LaneTracer (four paths in SIMD lanes), else by PathTracer
+  float focusDistance = 0;  // the thin lens's, autofocus resolved (0: a pinhole)
   double samplesPerSecond() const {
     return renderSeconds > 0 ? double(samples) / renderSeconds : 0;
   }

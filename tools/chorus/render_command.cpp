@@ -76,9 +76,8 @@ nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderOptions& op
   j["max_depth"] = options.maxDepth;
   j["roulette_depth"] = options.rouletteStartDepth;
   j["camera"] = options.camera;
-  if (options.lensRadius > 0)  // the focus distance as used (autofocus resolved)
-    j["lens"] = {{"radius", options.lensRadius},
-                 {"focus_distance", focusCamera(loaded.scene, options).focusDistance}};
+  if (options.lensRadius > 0)
+    j["lens"] = {{"radius", options.lensRadius}, {"focus_distance", s.focusDistance}};
   j["threads"] = options.threads;
   j["environment"] = args.sceneOptions.environmentLabel(loaded.scene);
   j["seconds"] = {{"load", loaded.loadSeconds},

@@ -157,6 +157,49 @@ TEST(EnsembleRunner, TheQuartersEstimateRunsTheHeldOutInputsInsteadOfTheHalves) 
   EXPECT_TRUE(two.bases[0].heldOut.empty());
 }
 
+// On an image of kFullRunPixels pixels at up to kFullRunSpp samples per pixel the quarters
+// estimate also runs each member on the full buffer and blends that run (not the mean of the
+// held-out runs); one sample per pixel more and it blends the mean again.
+TEST(EnsembleRunner, LargeImagesAtFewSamplesBlendTheFullRun) {
+  const synthetic::Scene scene = synthetic::makeScene(synthetic::SceneKind::Regions, 256, 128);
+  ASSERT_EQ(256L * 128L, kFullRunPixels);
+  const std::vector<EnsembleMember> members = {{"box3", std::make_shared<BoxDenoiser>(3)}};
+  const Ensemble ensemble(members, {});
+  const BoxDenoiser box3(3);
+  for (const int perQuarter : {4, 5}) {  // 16 and 20 samples per pixel
+    const SampleBuffers b = synthetic::renderBuffers(scene, {1.0f, perQuarter, 0.0f}, 4, 3);
+    const EnsembleResult result = ensemble.run(b);
+    const bool fullRun = double(4 * perQuarter) <= kFullRunSpp;
+    EXPECT_EQ(stagesOf(result).count("box3/full"), fullRun ? 1u : 0u) << perQuarter;
+    ASSERT_EQ(result.bases[0].heldOut.size(), 4u);
+    const Image expected =
+        fullRun ? box3.run(b.input(BufferPart::Full)) : meanOfHeldOutRuns(result.bases[0]);
+    EXPECT_TRUE(sameImage(result.bases[0].full, expected)) << perQuarter;
+  }
+  // Below the size, a run at few samples blends the mean (the rule's other side).
+  const synthetic::Scene small = synthetic::makeScene(synthetic::SceneKind::Regions, 255, 128);
+  const SampleBuffers b = synthetic::renderBuffers(small, {1.0f, 1, 0.0f}, 4, 3);
+  EXPECT_EQ(stagesOf(ensemble.run(b)).count("box3/full"), 0u);
+}
+
+// The quarters estimate compares each held-out run with its quarter as rendered: a firefly in
+// one quarter stays in that quarter's comparator (the outlier guard's clamps would take ordinary
+// bright samples off a one-sample quarter's mean and bias the estimate), while the halves, which
+// the halves estimate compares with, keep the guard's clamp.
+TEST(EnsembleRunner, TheQuartersAreComparedWithUnguarded) {
+  SampleBuffers b = buffers(4);
+  // One of quarter 1's four samples at (12, 9) is 1e4: its mean and variance of the mean as
+  // those samples give them (1e4 / 4 above the others; (1e4)^2 * 3/16 / 4 ... rounded: 6.25e6).
+  b.sub(1).color.mean(12, 9, 0) += 2500.0f;
+  b.sub(1).color.varianceOfMean(12, 9, 0) = 6.25e6f;
+  const EnsembleGuides guides = guidesFromSources(sourcesFromBuffers(b), true);
+  ASSERT_EQ(guides.quarters.size(), 4u);
+  for (int k = 0; k < 4; ++k)
+    EXPECT_TRUE(sameImage(guides.quarters[size_t(k)], b.sub(k).color.mean)) << k;
+  EXPECT_GT(guides.quarters[1](12, 9, 0), 2500.0f);
+  EXPECT_LT(guides.colorA(12, 9, 0), 100.0f);  // the half's mean would be above 1250
+}
+
 TEST(EnsembleRunner, HalvesOfTheirOwnInputNeedFourSubBuffers) {
   std::vector<EnsembleMember> members = boxMembers();
   members.push_back({"halves", std::make_shared<HalvesDenoiser>()});

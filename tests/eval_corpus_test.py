@@ -95,6 +95,20 @@ class SplitFile(unittest.TestCase):
         halves = {r.split("|")[1].strip(): r.split("|")[2].strip() for r in rows}
         self.assertEqual(halves, corpus_file.half_of(self.corpus))
 
+    def test_large_image_corpora_keep_the_split(self):
+        # corpus-256.json and corpus-512.json re-render entries of this corpus at the default
+        # job's sizes: each entry the same scene, environment and lens in the same half, both
+        # halves represented, so that what they decide is still tuned on one half only.
+        main = {e["name"]: e for e in self.entries}
+        for width in (256, 512):
+            large = corpus_file.load(os.path.join(EVAL, "corpus-%d.json" % width))
+            self.assertEqual({e["half"] for e in large["entries"]}, set(corpus_file.HALVES))
+            for e in large["entries"]:
+                self.assertIn(e["name"], main)
+                for key in ("half", "source", "scene", "env", "lens"):
+                    self.assertEqual(e.get(key), main[e["name"]].get(key), (width, e["name"], key))
+                self.assertEqual(e["width"], width, e["name"])
+
     def write_corpus(self, directory, entries):
         path = os.path.join(directory, "corpus.json")
         with open(path, "w") as f:

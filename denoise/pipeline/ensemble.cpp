@@ -110,8 +110,18 @@ BaseRuns baseRunsFor(const MseOptions& options, const EnsembleSources& sources) 
   BaseRuns runs;
   runs.heldOut = options.estimate != MseEstimate::Halves && hasQuarters(sources);
   runs.halves = !runs.heldOut || options.estimate == MseEstimate::Extrapolated;
-  runs.full = runs.halves;
+  // The render's samples per pixel: the mean of the full buffer's sample counts.
+  const Image& counts = sources.full.whole.sampleCount;
+  const size_t pixels = counts.pixelCount();
+  double samples = 0;
+  for (size_t i = 0; i < pixels; ++i) samples += double(counts.data()[i]);
+  const double spp = pixels > 0 ? samples / double(pixels) : 0.0;
+  runs.full = runs.halves || blendsFullRuns(counts.width(), counts.height(), spp);
   return runs;
+}
+
+bool blendsFullRuns(int width, int height, double samplesPerPixel) {
+  return long(width) * long(height) >= kFullRunPixels && samplesPerPixel <= kFullRunSpp;
 }
 
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,

@@ -62,11 +62,21 @@ struct BaseRuns {
 };
 // The runs an estimate needs on these sources: the quarters (and the extrapolated) estimate
 // use the held-out runs when the sources carry four independent quarters (K = 4). The quarters
-// estimate then needs nothing else: the half runs are left out (the estimate and the weight
-// filter's guide read only the held-out runs) and the full run too (the ensemble blends the
-// mean of the held-out runs, meanOfHeldOutRuns). The extrapolated estimate also needs the
-// halves and keeps the full run. Otherwise the full and the half runs.
+// estimate then needs no half runs (the estimate and the weight filter's guide read only the
+// held-out runs), and the full run only where blendsFullRuns says so; elsewhere the ensemble
+// blends the mean of the held-out runs (meanOfHeldOutRuns). The extrapolated estimate also
+// needs the halves and keeps the full run. Otherwise the full and the half runs.
 BaseRuns baseRunsFor(const MseOptions& options, const EnsembleSources& sources);
+
+// Whether the quarters estimate's blend takes each member's run on the full buffer (a fifth run)
+// instead of the mean of its four held-out runs: on images of at least kFullRunPixels pixels at
+// up to kFullRunSpp samples per pixel. There a held-out run sees three samples of four, split
+// 2 + 1 by the members that halve their input, and its mean stays well behind the full run; at
+// 128-160 px, and at 64 spp and more, the mean (an average of four runs) wins. Chosen on the
+// tuning halves of the corpora at 128-160, 256 and 512 px (docs/ensemble-quality.md).
+inline constexpr long kFullRunPixels = 32768;  // 2^15, e.g. 256 x 128
+inline constexpr double kFullRunSpp = 16;
+bool blendsFullRuns(int width, int height, double samplesPerPixel);
 // Every member on the runs that `runs` asks for, in parallel. Appends "<label>/A",
 // "<label>/B", "<label>/full", "<label>/without-q<k>" (the time of each run) and "bases" (wall
 // time of all of them) to `times`.

@@ -63,16 +63,15 @@ EnsembleGuides guidesFromSources(const EnsembleSources& sources, bool withQuarte
   guides.colorA = guardOutliers(sources.a).input.whole.color.mean;
   guides.colorB = guardOutliers(sources.b).input.whole.color.mean;
   // With K = 4 the halves' own halves are the quarters the leave-one-quarter-out estimate
-  // compares the held-out runs with (quarter k = half k / 2, own half k % 2). Each is guarded
-  // on its own samples: confirmed by the other quarter of its half, it would depend on samples
-  // that the run it is compared with has seen.
+  // compares the held-out runs with (quarter k = half k / 2, own half k % 2), as rendered: not
+  // guarded. A quarter holds a quarter of the samples (one at 4 spp), which never confirm a
+  // bright value, so the guard clamped ordinary samples of bright surfaces and took 1-5 % off
+  // every quarter's mean: the estimate then favoured members that were too dark, most where
+  // the members differ by little (512 px: docs/ensemble-quality.md). The outlier cap weighs
+  // down the fireflies they keep.
   if (withQuarters && sources.a.halves && sources.b.halves)
     for (const DenoiseInput* half : {&sources.a, &sources.b})
-      for (const SubBuffer& quarter : *half->halves) {
-        DenoiseInput alone;
-        alone.whole = quarter;
-        guides.quarters.push_back(guardOutliers(std::move(alone)).input.whole.color.mean);
-      }
+      for (const SubBuffer& quarter : *half->halves) guides.quarters.push_back(quarter.color.mean);
   guides.albedo = sources.full.whole.albedo.mean;
   guides.normal = sources.full.whole.normal.mean;
   return guides;

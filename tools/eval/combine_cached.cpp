@@ -21,6 +21,7 @@
 #include "denoise/base/registry.h"
 #include "denoise/ensemble/combiners.h"
 #include "denoise/metrics/metrics.h"
+#include "denoise/pipeline/ensemble.h"
 #include "tools/chorus/ensemble_flags.h"
 #include "tools/chorus/render_denoise.h"
 #include "tools/eval/cached_case.h"
@@ -55,7 +56,9 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
     BaseOutputs& o = outputs[m] = readCachedMember(caseDir, m);
     alone[m] = o.full;
     if (args.noHalfRuns && o.heldOut.size() == 4) o.a = o.b = Image();
-    if (args.fullFromHeldOut && o.heldOut.size() == 4) o.full = meanOfHeldOutRuns(o);
+    if (args.fullFromHeldOut && o.heldOut.size() == 4 &&
+        !blendsFullRuns(guides.width(), guides.height(), spp))
+      o.full = meanOfHeldOutRuns(o);
   }
   std::vector<sweep::SweepRow> rows = {
       sweep::measuredRow(args.name, spp, "noisy", "-", 0, guides.color, reference, 0, 0)};
@@ -160,7 +163,9 @@ int main(int argc, char** argv) {
   app.add_flag("--diagnose", args.diagnose,
                "Print each member's relMSE on A, B, full and held-out runs instead");
   app.add_flag("--full-from-held-out", args.fullFromHeldOut,
-               "Replace each member's full-buffer output by the mean of its four held-out runs");
+               "Replace each member's full-buffer output by the mean of its four held-out runs "
+               "where the pipeline blends that mean (blendsFullRuns: not on images of >= 32768 "
+               "pixels at <= 16 spp)");
   app.add_flag("--no-half-runs", args.noHalfRuns,
                "Drop the members' half runs where held-out runs replace them (as the pipeline "
                "does for the quarters estimate)");

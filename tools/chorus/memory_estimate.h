@@ -13,12 +13,15 @@
 namespace chorus::cli {
 
 // Peak bytes of rendering `size` into `splits` sub-buffers, writing render.exr and running
-// `members` (none: no denoising) with their combination.
+// `members` (none: no denoising) with their combination; `fullRun`: the members also run on the
+// full buffer, whose halves are then kept (K = 4: the sweep always, a render where
+// blendsFullRuns holds or the estimate is not the quarters).
 uint64_t estimatePeakBytes(render::Resolution size, int splits,
-                           std::span<const EnsembleMember> members);
+                           std::span<const EnsembleMember> members, bool fullRun);
 
 // Throws chorus::Error "rendering WxH with K sub-buffers and N denoisers needs X GiB, this machine
 // has Y GiB available" when the estimate exceeds the memory available.
-void checkRunMemory(render::Resolution size, int splits, std::span<const EnsembleMember> members);
+void checkRunMemory(render::Resolution size, int splits, std::span<const EnsembleMember> members,
+                    bool fullRun);
 
 }  // namespace chorus::cli

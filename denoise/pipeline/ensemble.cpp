@@ -40,6 +40,11 @@ bool needsHalves(const EnsembleMember& member) {
 
 }  // namespace
 
+// The full buffer's halves are the half inputs' wholes (addHalvesOfFull).
+bool canMakeFullHalves(const EnsembleSources& sources) {
+  return !sources.a.whole.color.mean.empty() && !sources.b.whole.color.mean.empty();
+}
+
 void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members,
                         bool fullRun) {
   checkLabels(members);
@@ -48,10 +53,11 @@ void checkMembersCanRun(const EnsembleSources& sources, std::span<const Ensemble
                 std::to_string(members.size()));
   for (const EnsembleMember& member : members) {
     if (!needsHalves(member)) continue;
-    const char* missing = !sources.a.halves                 ? "half A"
-                          : !sources.b.halves               ? "half B"
-                          : fullRun && !sources.full.halves ? "the full buffer"
-                                                            : nullptr;
+    const char* missing = !sources.a.halves                                   ? "half A"
+                          : !sources.b.halves                                 ? "half B"
+                          : fullRun && !sources.full.halves && !canMakeFullHalves(sources)
+                              ? "the full buffer"
+                              : nullptr;
     if (missing)
       throw Error("base denoiser '" + member.label +
                   "' needs two independent halves of its own input, but " + missing +
@@ -131,26 +137,37 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
   const Stopwatch all;
   if (!runs.full && !runs.heldOut)
     throw Error("runBaseDenoisers: without the full run the held-out runs are needed");
-  // Every input: its name in `times`, where its runs' outputs go, and the input (none for the
-  // held-out inputs, which come last). A held-out input is built when its runs start and freed
-  // when they end: each holds three sub-buffers of every plane (2.3 GB at 4K), and four at once
-  // did not fit a 4K render in 24 GiB.
+  // Every input: its name in `times`, where its runs' outputs go, and the input the sources
+  // hold, or else how to build it (those come last). A built input exists only while its runs
+  // do: a held-out input holds three sub-buffers of every plane (2.3 GB at 4K), and four at
+  // once did not fit a 4K render in 24 GiB; the full buffer with halves the sources do not hold
+  // (a render keeps none: two more copies of every plane through every run) likewise.
   struct Part {
     std::string name;
     std::function<Image&(BaseOutputs&)> output;
     const DenoiseInput* input = nullptr;
+    std::function<DenoiseInput()> build = nullptr;
   };
   std::vector<Part> plan;
-  if (runs.full) plan.push_back({"full", &BaseOutputs::full, &sources.full});
+  const bool buildFull = runs.full && !sources.full.halves && readsHalves(members) &&
+                         canMakeFullHalves(sources);
+  if (runs.full && !buildFull) plan.push_back({"full", &BaseOutputs::full, &sources.full});
   if (runs.halves) {
     plan.push_back({"A", &BaseOutputs::a, &sources.a});
     plan.push_back({"B", &BaseOutputs::b, &sources.b});
   }
   const size_t own = plan.size();
+  if (buildFull)
+    plan.push_back({"full", &BaseOutputs::full, nullptr, [&sources] {
+                      DenoiseInput full = sources.full;
+                      full.halves = std::array<SubBuffer, 2>{sources.a.whole, sources.b.whole};
+                      return full;
+                    }});
   if (runs.heldOut)
     for (int k = 0; k < kHeldOutQuarters; ++k)
       plan.push_back({"without-q" + std::to_string(k),
-                      [k](BaseOutputs& o) -> Image& { return o.heldOut[size_t(k)]; }});
+                      [k](BaseOutputs& o) -> Image& { return o.heldOut[size_t(k)]; }, nullptr,
+                      [&sources, k] { return heldOutInput(sources, k); }});
   const size_t parts = plan.size();
   std::vector<BaseOutputs> outputs(members.size());
   for (size_t m = 0; m < members.size(); ++m) {
@@ -182,7 +199,7 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
   };
   runParts(0, own, nullptr);  // the inputs the sources hold, all at once
   for (size_t part = own; part < parts; ++part) {
-    const DenoiseInput input = heldOutInput(sources, int(part - own));
+    const DenoiseInput input = plan[part].build();
     runParts(part, part + 1, &input);
   }
   if (!runs.full)

@@ -163,7 +163,10 @@ MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& spec
   checkFeaturesHeld(input, members, true);
   EnsembleSources sources;
   try {
-    sources = input.render ? sourcesFromBuffers(*input.render) : sourcesFromHalves(*input.tungsten);
+    // The full buffer's halves, when a run on it needs them, are built for that run only
+    // (runBaseDenoisers).
+    sources =
+        input.render ? sourcesFromBuffers(*input.render, false) : sourcesFromHalves(*input.tungsten);
     checkMembersCanRun(sources, members);
   } catch (const Error& e) {
     throw fileError(input.path, e.what() + inputHint(input, false));

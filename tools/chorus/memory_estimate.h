@@ -14,8 +14,8 @@ namespace chorus::cli {
 
 // Peak bytes of rendering `size` into `splits` sub-buffers, writing render.exr and running
 // `members` (none: no denoising) with their combination; `fullRun`: the members also run on the
-// full buffer, whose halves are then kept (K = 4: the sweep always, a render where
-// blendsFullRuns holds or the estimate is not the quarters).
+// full buffer, whose halves are kept through every run (K = 4: the sweep; a render builds them
+// for the full run only, after the held-out inputs are gone).
 uint64_t estimatePeakBytes(render::Resolution size, int splits,
                            std::span<const EnsembleMember> members, bool fullRun);
 

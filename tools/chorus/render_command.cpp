@@ -134,9 +134,7 @@ void runRender(RenderArgs args) {
   // Everything that can be checked fails here, before the render allocates its film.
   const Resolution size = renderResolution(loaded.scene, options);
   if (reference) checkReferenceSize(*reference, args.reference, size.width, size.height);
-  checkRunMemory(size, options.splits, denoise.members,
-                 denoise.options.mse.estimate != MseEstimate::Quarters ||
-                     blendsFullRuns(size.width, size.height, options.spp));
+  checkRunMemory(size, options.splits, denoise.members, false);
   focusCamera(loaded.scene, options);  // a lens its camera cannot take, nothing to focus on
   OwnedDirectory out(args.out);        // held until every file is written
 
@@ -167,11 +165,11 @@ void runRender(RenderArgs args) {
   if (denoise.enabled()) {
     sources = args.preview ? sourcesFromBuffers(std::move(result.buffers), false)
                            : sourcesFromBuffers(result.buffers, false);
-    // The full buffer's halves (two copies of every plane, 1.5 GB at 4K) only for a run on the
-    // full buffer (none with the quarters estimate), and in a preview only for members that
-    // read them.
-    if (baseRunsFor(denoise.options.mse, *sources).full &&
-        (!args.preview || readsHalves(denoise.members)))
+    // The full buffer's halves (two copies of every plane, 1.5 GB at 4K) are built for the run
+    // on the full buffer only, while it runs (runBaseDenoisers); a preview whose members read
+    // them holds them from the start, so that its full run goes with its half runs.
+    if (args.preview && readsHalves(denoise.members) &&
+        baseRunsFor(denoise.options.mse, *sources).full)
       addHalvesOfFull(*sources);
   }
   const Stopwatch write;

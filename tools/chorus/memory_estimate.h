@@ -15,7 +15,7 @@ namespace chorus::cli {
 // Peak bytes of rendering `size` into `splits` sub-buffers, writing render.exr and running
 // `members` (none: no denoising) with their combination; `fullRun`: the members also run on the
 // full buffer, whose halves are kept through every run (K = 4: the sweep; a render builds them
-// for the full run only, after the held-out inputs are gone).
+// for the full run only, one at a time with the held-out inputs).
 uint64_t estimatePeakBytes(render::Resolution size, int splits,
                            std::span<const EnsembleMember> members, bool fullRun);
 

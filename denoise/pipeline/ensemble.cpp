@@ -40,24 +40,14 @@ bool needsHalves(const EnsembleMember& member) {
 
 }  // namespace
 
-// The full buffer's halves are the half inputs' wholes (addHalvesOfFull).
-bool canMakeFullHalves(const EnsembleSources& sources) {
-  return !sources.a.whole.color.mean.empty() && !sources.b.whole.color.mean.empty();
-}
-
-void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members,
-                        bool fullRun) {
+void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members) {
   checkLabels(members);
   if (members.size() > size_t(kMaxDenoisers))
     throw Error("at most " + std::to_string(kMaxDenoisers) + " base denoisers, got " +
                 std::to_string(members.size()));
   for (const EnsembleMember& member : members) {
     if (!needsHalves(member)) continue;
-    const char* missing = !sources.a.halves                                   ? "half A"
-                          : !sources.b.halves                                 ? "half B"
-                          : fullRun && !sources.full.halves && !canMakeFullHalves(sources)
-                              ? "the full buffer"
-                              : nullptr;
+    const char* missing = !sources.a.halves ? "half A" : !sources.b.halves ? "half B" : nullptr;
     if (missing)
       throw Error("base denoiser '" + member.label +
                   "' needs two independent halves of its own input, but " + missing +
@@ -116,13 +106,8 @@ BaseRuns baseRunsFor(const MseOptions& options, const EnsembleSources& sources) 
   BaseRuns runs;
   runs.heldOut = options.estimate != MseEstimate::Halves && hasQuarters(sources);
   runs.halves = !runs.heldOut || options.estimate == MseEstimate::Extrapolated;
-  // The render's samples per pixel: the mean of the full buffer's sample counts.
-  const Image& counts = sources.full.whole.sampleCount;
-  const size_t pixels = counts.pixelCount();
-  double samples = 0;
-  for (size_t i = 0; i < pixels; ++i) samples += double(counts.data()[i]);
-  const double spp = pixels > 0 ? samples / double(pixels) : 0.0;
-  runs.full = runs.halves || blendsFullRuns(counts.width(), counts.height(), spp);
+  runs.full = runs.halves || blendsFullRuns(sources.width(), sources.height(),
+                                            meanSampleCount(sources.full.whole));
   return runs;
 }
 
@@ -133,7 +118,7 @@ bool blendsFullRuns(int width, int height, double samplesPerPixel) {
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
                                           std::vector<StageTime>* times, BaseRuns runs) {
-  checkMembersCanRun(sources, members, runs.full);
+  checkMembersCanRun(sources, members);
   const Stopwatch all;
   if (!runs.full && !runs.heldOut)
     throw Error("runBaseDenoisers: without the full run the held-out runs are needed");
@@ -141,7 +126,7 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
   // hold, or else how to build it (those come last). A built input exists only while its runs
   // do: a held-out input holds three sub-buffers of every plane (2.3 GB at 4K), and four at
   // once did not fit a 4K render in 24 GiB; the full buffer with halves the sources do not hold
-  // (a render keeps none: two more copies of every plane through every run) likewise.
+  // (renders and sweeps keep none: two more copies of every plane through every run) likewise.
   struct Part {
     std::string name;
     std::function<Image&(BaseOutputs&)> output;
@@ -149,8 +134,7 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
     std::function<DenoiseInput()> build = nullptr;
   };
   std::vector<Part> plan;
-  const bool buildFull = runs.full && !sources.full.halves && readsHalves(members) &&
-                         canMakeFullHalves(sources);
+  const bool buildFull = runs.full && !sources.full.halves && readsHalves(members);
   if (runs.full && !buildFull) plan.push_back({"full", &BaseOutputs::full, &sources.full});
   if (runs.halves) {
     plan.push_back({"A", &BaseOutputs::a, &sources.a});
@@ -160,7 +144,7 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
   if (buildFull)
     plan.push_back({"full", &BaseOutputs::full, nullptr, [&sources] {
                       DenoiseInput full = sources.full;
-                      full.halves = std::array<SubBuffer, 2>{sources.a.whole, sources.b.whole};
+                      full.halves = fullBufferHalves(sources);
                       return full;
                     }});
   if (runs.heldOut)

@@ -29,10 +29,9 @@ std::vector<EnsembleMember> membersFromSpecs(std::span<const std::string> specs)
 
 // Throws chorus::Error (one line) when a member cannot run on these sources, e.g. a denoiser
 // that needs two halves of its own input while the half buffers have none (K = 2 renders and
-// Tungsten directories: only the full buffer has halves). The full buffer's halves are needed
-// only when the members run on the full buffer (`fullRun`; baseRunsFor).
-void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members,
-                        bool fullRun = true);
+// Tungsten directories: only the full buffer has halves). The full buffer's halves, when the
+// sources do not hold them, are built for the run on it (runBaseDenoisers).
+void checkMembersCanRun(const EnsembleSources& sources, std::span<const EnsembleMember> members);
 
 // Sub-buffers a render needs for these members: 4 when one needs two halves of its own input (it
 // then runs on quarters inside each half: NFOR, RDFC, dual-buffer NL-means), else 2 (the

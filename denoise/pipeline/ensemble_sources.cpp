@@ -22,10 +22,12 @@ EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers, bool halvesOfFu
   return sources;
 }
 
-void addHalvesOfFull(EnsembleSources& sources) {
-  // The full buffer's halves are the half inputs' wholes: copied rather than merged again.
-  sources.full.halves = std::array<SubBuffer, 2>{sources.a.whole, sources.b.whole};
+std::array<SubBuffer, 2> fullBufferHalves(const EnsembleSources& sources) {
+  // Copied rather than merged again.
+  return {sources.a.whole, sources.b.whole};
 }
+
+void addHalvesOfFull(EnsembleSources& sources) { sources.full.halves = fullBufferHalves(sources); }
 
 EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull) {
   const int k = buffers.splitCount();

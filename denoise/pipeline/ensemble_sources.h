@@ -2,6 +2,8 @@
 // The three inputs every base denoiser of an ensemble runs on (half A, half B, the full buffer),
 // made from a render's sub-buffers or from an input that already has two halves, and the noisy
 // guides the combination step reads from them.
+#include <array>
+
 #include "denoise/buffers/sample_buffers.h"
 #include "denoise/ensemble/ensemble_inputs.h"
 
@@ -25,7 +27,9 @@ EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers, bool halvesOfFu
 // `buffers` is left empty).
 EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull);
 
-// full.halves = the half inputs' wholes (copies of every plane of both).
+// The full buffer's halves: the half inputs' wholes (copies of every plane of both).
+std::array<SubBuffer, 2> fullBufferHalves(const EnsembleSources& sources);
+// full.halves = fullBufferHalves(sources).
 void addHalvesOfFull(EnsembleSources& sources);
 
 // From an input with two halves (e.g. a Tungsten directory): a = halves[0], b = halves[1]

@@ -150,10 +150,7 @@ int main(int argc, char** argv) {
   const int splits = splitsNeeded(defaults);
   for (const render::Resolution size :
        {render::Resolution{1920, 1080}, render::Resolution{3840, 2160}}) {
-    const double gib = double(cli::estimatePeakBytes(
-                           size, splits, defaults,
-                           blendsFullRuns(size.width, size.height, render::RenderOptions{}.spp))) /
-                       double(1 << 30);
+    const double gib = double(cli::estimatePeakBytes(size, splits, defaults)) / double(1 << 30);
     std::printf("  %4dx%-5d K = %d: %.2f GiB estimated, %s 24 GiB\n", size.width, size.height,
                 splits, gib, gib <= 24.0 ? "fits in" : "exceeds");
   }

@@ -19,11 +19,11 @@ constexpr double kRenderBytesPerSubBuffer = 141;
 // The denoisers' inputs: copies of 23 float planes. At K = 4, 9: the sources keep 7 (A and B
 // with two halves each, the full buffer) and the held-out input being run holds 3, prepared
 // once for all members (member_runner.h), less what is freed by then (measured 6.6-7.5; 9 keeps
-// the estimate 5-8 % above every calibration point); 2 more when the members also run on the
-// full buffer, which keeps its halves (measured 960x540, 4 spp: +92 MiB). At K = 2, 5 (no
-// halves in A and B).
+// the estimate 5-8 % above every calibration point). The input of a run on the full buffer with
+// its halves (3) is built one at a time with the held-out inputs. At K = 2, 5 (no halves in A
+// and B).
 constexpr double kSourceBytesPerCopy = 92;
-constexpr int kSourceCopiesK4 = 9, kFullRunHalvesCopies = 2, kSourceCopiesK2 = 5;
+constexpr int kSourceCopiesK4 = 9, kSourceCopiesK2 = 5;
 // Per pixel, what a member's runs and the combination add at their peak (the member
 // alone, K = 4, beyond the render and the sources). Peaks of several members did not add up
 // (480x270: nfor alone 338 MiB, nfor,rdfc,atrous 347 MiB, all seven members 328 MiB): the
@@ -50,13 +50,11 @@ double memberPeak(const EnsembleMember& member) {
 }  // namespace
 
 uint64_t estimatePeakBytes(render::Resolution size, int splits,
-                           std::span<const EnsembleMember> members, bool fullRun) {
+                           std::span<const EnsembleMember> members) {
   const double pixels = double(size.width) * double(size.height);
   double perPixel = splits * kRenderBytesPerSubBuffer;
   if (!members.empty()) {
-    const int copies =
-        splits == 4 ? kSourceCopiesK4 + (fullRun ? kFullRunHalvesCopies : 0) : kSourceCopiesK2;
-    perPixel += copies * kSourceBytesPerCopy;
+    perPixel += (splits == 4 ? kSourceCopiesK4 : kSourceCopiesK2) * kSourceBytesPerCopy;
     double largest = 0;
     for (const EnsembleMember& member : members) largest = std::max(largest, memberPeak(member));
     perPixel += largest + double(members.size() - 1) * kFurtherMemberBytes;
@@ -64,12 +62,11 @@ uint64_t estimatePeakBytes(render::Resolution size, int splits,
   return uint64_t(kFixedBytes + pixels * perPixel);
 }
 
-void checkRunMemory(render::Resolution size, int splits, std::span<const EnsembleMember> members,
-                    bool fullRun) {
+void checkRunMemory(render::Resolution size, int splits, std::span<const EnsembleMember> members) {
   std::string what = "rendering " + std::to_string(size.width) + "x" + std::to_string(size.height) +
                      " with " + std::to_string(splits) + " sub-buffer(s)";
   if (!members.empty()) what += " and " + std::to_string(members.size()) + " denoiser(s)";
-  checkMemoryBudget(estimatePeakBytes(size, splits, members, fullRun), what);
+  checkMemoryBudget(estimatePeakBytes(size, splits, members), what);
 }
 
 }  // namespace chorus::cli

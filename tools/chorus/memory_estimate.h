@@ -13,15 +13,12 @@
 namespace chorus::cli {
 
 // Peak bytes of rendering `size` into `splits` sub-buffers, writing render.exr and running
-// `members` (none: no denoising) with their combination; `fullRun`: the members also run on the
-// full buffer, whose halves are kept through every run (K = 4: the sweep; a render builds them
-// for the full run only, one at a time with the held-out inputs).
+// `members` (none: no denoising) with their combination.
 uint64_t estimatePeakBytes(render::Resolution size, int splits,
-                           std::span<const EnsembleMember> members, bool fullRun);
+                           std::span<const EnsembleMember> members);
 
 // Throws chorus::Error "rendering WxH with K sub-buffers and N denoisers needs X GiB, this machine
 // has Y GiB available" when the estimate exceeds the memory available.
-void checkRunMemory(render::Resolution size, int splits, std::span<const EnsembleMember> members,
-                    bool fullRun);
+void checkRunMemory(render::Resolution size, int splits, std::span<const EnsembleMember> members);
 
 }  // namespace chorus::cli

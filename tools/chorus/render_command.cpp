@@ -134,7 +134,7 @@ void runRender(RenderArgs args) {
   // Everything that can be checked fails here, before the render allocates its film.
   const Resolution size = renderResolution(loaded.scene, options);
   if (reference) checkReferenceSize(*reference, args.reference, size.width, size.height);
-  checkRunMemory(size, options.splits, denoise.members, false);
+  checkRunMemory(size, options.splits, denoise.members);
   focusCamera(loaded.scene, options);  // a lens its camera cannot take, nothing to focus on
   OwnedDirectory out(args.out);        // held until every file is written
 

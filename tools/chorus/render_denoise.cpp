@@ -29,7 +29,7 @@ DenoiseStage DenoiseStage::parse(const std::string& list, CombineOptions options
 double DenoiseStage::run(const EnsembleSources& sources, const std::filesystem::path& dir,
                          nlohmann::ordered_json& stats, const Image* reference) const {
   const Ensemble ensemble(members, options);
-  checkMembersCanRun(sources, ensemble.members(), baseRunsFor(options.mse, sources).full);
+  checkMembersCanRun(sources, ensemble.members());
   checkPlanesHeld(sources.full.whole.planes(), ensemble.members(), true);
   const Stopwatch denoise;
   const EnsembleResult result = ensemble.run(sources);

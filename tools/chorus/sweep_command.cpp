@@ -116,15 +116,14 @@ void runSweepCommand(const SweepArgs& args) {
   config.environment = args.scene.environment();
   config.combine = args.ensemble.options();
   config.cropSize = args.cropSize;
-  // Every case renders with K = 4 and runs every method (on the full buffer too, whose halves it
-  // keeps: a member alone is its full run): checked before anything is written
+  // Every case renders with K = 4 and runs every method: checked before anything is written
   // when --width and --height fix the size, else as each scene is loaded (its camera decides).
   const std::vector<EnsembleMember> members = membersFromSpecs(config.methods);
   if (config.render.width > 0 && config.render.height > 0)
-    checkRunMemory({config.render.width, config.render.height}, 4, members, true);
+    checkRunMemory({config.render.width, config.render.height}, 4, members);
   config.loadScene = [&](const fs::path& path) {
     render::Scene scene = std::move(loadScene(path.string(), args.scene, args.quiet).scene);
-    checkRunMemory(render::renderResolution(scene, config.render), 4, members, true);
+    checkRunMemory(render::renderResolution(scene, config.render), 4, members);
     return scene;
   };
   config.progress = args.quiet ? nullptr : &std::cerr;

@@ -195,7 +195,8 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
   const render::RenderResult render = render::render(scene, options);
   const double renderSeconds = render.stats.renderSeconds;
 
-  const EnsembleSources sources = sourcesFromBuffers(render.buffers);
+  // The full buffer's halves are built for the full runs only (runBaseDenoisers).
+  const EnsembleSources sources = sourcesFromBuffers(render.buffers, false);
   checkMembersCanRun(sources, plan.members);
   std::vector<StageTime> times;
   BaseRuns runs = baseRunsFor(config.combine.mse, sources);

@@ -124,6 +124,9 @@ TEST(DenoiseCli, OptionsReachTheLibrary) {
   const json stats = readJson(out / "stats.json");
   EXPECT_EQ(stats["options"]["noisy_fallback"], 1.5);
   EXPECT_EQ(stats["noisy_fallback_pixels"].get<size_t>(), direct.noisyFallbackPixels);
+  // --window sets the one radius used everywhere, full-run blends included.
+  EXPECT_EQ(stats["options"]["window"], 0);
+  EXPECT_EQ(stats["options"]["full_run_window"], 0);
 }
 
 TEST(DenoiseCli, CleanFailures) {

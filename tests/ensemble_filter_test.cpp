@@ -58,6 +58,8 @@ std::vector<double> naiveFilter(const PlanarGuides& g, const BilateralKernel& k,
       double weight = 0;
       for (int qy = std::max(0, y - k.radius); qy <= std::min(h - 1, y + k.radius); ++qy)
         for (int qx = std::max(0, x - k.radius); qx <= std::min(w - 1, x + k.radius); ++qx) {
+          // A sparse kernel's taps: offsets that are multiples of its step.
+          if ((qx - x) % k.step != 0 || (qy - y) % k.step != 0) continue;
           const size_t q = size_t(qy) * size_t(w) + size_t(qx);
           double d = k.kSpatial * ((qx - x) * (qx - x) + (qy - y) * (qy - y));
           for (int c = 0; c < 3; ++c) {
@@ -96,11 +98,14 @@ std::vector<float> filterAll(const PlanarGuides& g, const BilateralKernel& k,
 TEST(PlanarFilter, MatchesNaiveBilateral) {
   // 300 pixels wide: three column blocks of the implementation; bands of 5 rows.
   const int w = 300, h = 23;
+  // {radius, step}: dense, and sparse with the radius a multiple of the step or not.
+  const std::pair<int, int> shapes[] = {{0, 1}, {1, 1}, {3, 1}, {7, 1}, {9, 3}, {10, 3}, {7, 2}};
   for (bool color : {false, true})
-    for (int radius : {0, 1, 3, 7}) {
+    for (const auto& [radius, step] : shapes) {
       const PlanarGuides g = randomGuides(w, h, 31 + uint32_t(radius), color);
       BilateralKernel k;
       k.radius = radius;
+      k.step = step;
       k.kSpatial = 0.5f / 9.0f;
       k.kNormal = 5.0f;
       k.kAlbedo = 8.0f;
@@ -111,7 +116,7 @@ TEST(PlanarFilter, MatchesNaiveBilateral) {
       const std::vector<float> got = filterAll(g, k, planes, count, 5);
       for (size_t e = 0; e < expected.size(); ++e)
         ASSERT_NEAR(got[e], expected[e], 2e-5 * (1 + std::abs(expected[e])))
-            << "radius " << radius << " color " << color << " element " << e;
+            << "radius " << radius << " step " << step << " color " << color << " element " << e;
     }
 }
 

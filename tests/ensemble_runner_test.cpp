@@ -182,6 +182,37 @@ TEST(EnsembleRunner, LargeImagesAtFewSamplesBlendTheFullRun) {
   EXPECT_EQ(stagesOf(ensemble.run(b)).count("box3/full"), 0u);
 }
 
+// Where the blend takes the full runs (large images at few samples) of members that split their
+// own input, the weights come from the wider window (mse.fullRunWindowRadius); members that do
+// not, or blends of the held-out means, keep mse.windowRadius.
+TEST(EnsembleRunner, FullRunsOfMembersThatSplitTheirInputGetTheWiderWindow) {
+  const synthetic::Scene scene = synthetic::makeScene(synthetic::SceneKind::Regions, 256, 128);
+  std::vector<EnsembleMember> splitting = boxMembers();
+  splitting.push_back({"halves", std::make_shared<HalvesDenoiser>()});
+  const auto blendWith = [](const EnsembleResult& result, int radius) {
+    CombineOptions o;
+    o.mse.windowRadius = radius;
+    return combine(result.guides, pointersTo(result.bases), o).image;
+  };
+  for (const int perQuarter : {1, 5}) {  // 4 spp: full runs blended; 20 spp: held-out means
+    const SampleBuffers b = synthetic::renderBuffers(scene, {1.0f, perQuarter, 0.0f}, 4, 5);
+    for (const bool split : {true, false}) {
+      const EnsembleResult result = Ensemble(split ? splitting : boxMembers(), {}).run(b);
+      const bool wide = split && perQuarter == 1;
+      const MseOptions defaults;
+      ASSERT_NE(defaults.windowRadius, defaults.fullRunWindowRadius);
+      EXPECT_TRUE(sameImage(result.combined.image,
+                            blendWith(result, wide ? defaults.fullRunWindowRadius
+                                                   : defaults.windowRadius)))
+          << perQuarter << " " << split;
+      EXPECT_FALSE(sameImage(result.combined.image,
+                             blendWith(result, wide ? defaults.windowRadius
+                                                    : defaults.fullRunWindowRadius)))
+          << perQuarter << " " << split;
+    }
+  }
+}
+
 // The quarters estimate compares each held-out run with its quarter as rendered: a firefly in
 // one quarter stays in that quarter's comparator (the outlier guard's clamps would take ordinary
 // bright samples off a one-sample quarter's mean and bias the estimate), while the halves, which

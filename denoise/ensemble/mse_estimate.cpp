@@ -46,6 +46,39 @@ bool finite3(const float* v) {
 }
 
 // Index of (i, j), i ≤ j, in the packed upper triangle of an n × n matrix.
+// The window's tap spacing: dense up to radius 8, every third pixel beyond, over 3 × 3 box means
+// of the terms (boxMeans), so that the radius-15 window costs what a radius-5 one does (and, on
+// the 256- and 512-px corpora, blends better than the dense radius-15 window:
+// docs/ensemble-quality.md).
+int windowStep(int radius) { return radius > 8 ? 3 : 1; }
+
+// Per plane (`planes` planes of `rows` rows × width), the mean over the (2b + 1)² box around each
+// pixel, clipped to the planes' rows and columns.
+std::vector<float> boxMeans(const std::vector<float>& in, int planes, int rows, int width, int b) {
+  const size_t pixels = size_t(rows) * size_t(width);
+  std::vector<float> horizontal(pixels), out(size_t(planes) * pixels);
+  for (int k = 0; k < planes; ++k) {
+    const float* src = in.data() + size_t(k) * pixels;
+    for (int y = 0; y < rows; ++y)
+      for (int x = 0; x < width; ++x) {
+        const int x0 = std::max(0, x - b), x1 = std::min(width - 1, x + b);
+        float sum = 0;
+        for (int q = x0; q <= x1; ++q) sum += src[size_t(y) * size_t(width) + size_t(q)];
+        horizontal[size_t(y) * size_t(width) + size_t(x)] = sum / float(x1 - x0 + 1);
+      }
+    float* dst = out.data() + size_t(k) * pixels;
+    for (int y = 0; y < rows; ++y) {
+      const int y0 = std::max(0, y - b), y1 = std::min(rows - 1, y + b);
+      for (int x = 0; x < width; ++x) {
+        float sum = 0;
+        for (int q = y0; q <= y1; ++q) sum += horizontal[size_t(q) * size_t(width) + size_t(x)];
+        dst[size_t(y) * size_t(width) + size_t(x)] = sum / float(y1 - y0 + 1);
+      }
+    }
+  }
+  return out;
+}
+
 int packed(int i, int j, int n) {
   return i * n - i * (i - 1) / 2 + (j - i);
 }
@@ -174,6 +207,7 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
     const float sigmaSpatial =
         options.windowSigmaSpatial > 0 ? options.windowSigmaSpatial : float(options.windowRadius);
     windowKernel_.radius = options.windowRadius;
+    windowKernel_.step = windowStep(options.windowRadius);
     windowKernel_.kSpatial = 0.5f / (sigmaSpatial * sigmaSpatial);
     windowKernel_.kNormal = 0.5f / (options.windowSigmaNormal * options.windowSigmaNormal);
     windowKernel_.kAlbedo = 0.5f / (options.windowSigmaAlbedo * options.windowSigmaAlbedo);
@@ -579,7 +613,9 @@ MseRows MseEstimator::rows(int y0, int y1) const {
   // terms at all) are filtered alongside, and entry (i, j) is divided by the window's share of
   // pixels with both present: the window's mean over the pixels that have the entry (exact
   // where one base has holes, an approximation where several have different ones).
-  const int inY0 = std::max(0, y0 - r), inY1 = std::min(height_, y1 + r);
+  // A sparse window's taps read box means (below): half a box more of halo.
+  const int halo = r + windowStep(r) / 2;
+  const int inY0 = std::max(0, y0 - halo), inY1 = std::min(height_, y1 + halo);
   std::vector<float> in;
   const std::vector<BaseMask> present = pixelTerms(inY0, inY1, in, objectiveEpsilon());
   const size_t inPixels = size_t(inY1 - inY0) * size_t(width_);
@@ -605,6 +641,14 @@ MseRows MseEstimator::rows(int y0, int y1) const {
     inPlanes.push_back(in.data() + size_t(k) * inPixels);
     outPlanes.push_back(k < planeCount() ? out.planes_.data() + size_t(k) * pixels
                                          : outPresence.data() + size_t(k - planeCount()) * pixels);
+  }
+  std::vector<float> boxed;
+  if (windowStep(r) > 1) {
+    // Taps every `step` pixels over step × step box means of the terms: as many pixels' terms
+    // as the dense window averages, at 1/step² of its taps.
+    boxed = boxMeans(in, planeCount() + presencePlanes, inY1 - inY0, width_, windowStep(r) / 2);
+    for (int k = 0; k < planeCount() + presencePlanes; ++k)
+      inPlanes[size_t(k)] = boxed.data() + size_t(k) * inPixels;
   }
   filterPlaneRows(windowGuides_, windowKernel_, inPlanes, inY0, y0, y1, outPlanes);
   if (holes) {

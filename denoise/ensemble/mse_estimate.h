@@ -112,6 +112,9 @@ struct MseOptions {
   MseForm form = MseForm::Summed;
   MseEstimate estimate = MseEstimate::Quarters;
   int windowRadius = 5;
+  // The radius the pipeline uses instead where the weights blend the members' full runs and a
+  // member splits its own input (optionsForRuns, denoise/pipeline/ensemble.h).
+  int fullRunWindowRadius = 15;
   bool relative = false;
   double outlierCap = 30.0;
   double consistency = 4.0;

@@ -110,7 +110,7 @@ CHORUS_SIMD_CLONES_EXACT void kernelRow(const PlanarGuides& g, const BilateralKe
 //   acc:    plane 0 the weight sum Σk, plane 1 + j the weighted sum of plane j; rows y0 … y1 − 1
 //           of `width` floats from column x0.
 struct Tile {
-  int width, stride, r;
+  int width, stride, r, step;
   const float* source;
   size_t sourcePlane;
   const float* kernel;
@@ -151,7 +151,7 @@ template <int G, bool kSum>
   const size_t minusRow = size_t(row.y - row.dy + t.r) * size_t(t.stride);
   const float* kPlusRow = t.kernel + size_t(row.plusSlot) * size_t(t.stride) + size_t(col + t.r);
   const float* kMinusRow = t.kernel + size_t(row.minusSlot) * size_t(t.stride) + size_t(col + t.r);
-  for (int dx = row.dxLo; dx <= t.r; ++dx) {
+  for (int dx = row.dxLo; dx <= t.r; dx += t.step) {
     // k(p, p + δ) is stored at s = p, k(p − δ, p) at s = p − δ.
     const size_t plane = size_t(dx + t.r) * t.kernelPlane;
     Lanes kPlus, kMinus;
@@ -211,6 +211,8 @@ void filterPlaneRows(const PlanarGuides& guides, const BilateralKernel& kernel,
                      std::span<const float* const> in, int inY0, int y0, int y1,
                      std::span<float* const> out) {
   const int w = guides.width, h = guides.height, r = std::max(0, kernel.radius);
+  const int step = std::clamp(kernel.step, 1, std::max(1, r));
+  const int reach = r / step * step;  // the furthest offset on the grid of steps
   const int planes = int(in.size());
   const int rows = y1 - y0;
   if (planes == 0 || rows <= 0) return;
@@ -227,6 +229,7 @@ void filterPlaneRows(const PlanarGuides& guides, const BilateralKernel& kernel,
   Tile tile;
   tile.stride = stride;
   tile.r = r;
+  tile.step = step;
   tile.source = source.data();
   tile.sourcePlane = size_t(rows + 2 * r) * size_t(stride);
   tile.kernel = k.data();
@@ -260,12 +263,12 @@ void filterPlaneRows(const PlanarGuides& guides, const BilateralKernel& kernel,
 
     // Per row of offsets dy, kernel rows s = y0 − dy … y1 − 1 in turn; output row y takes its
     // terms once kernel row s = y exists (row y − dy is still in the ring).
-    for (int dy = 0; dy <= r; ++dy) {
-      const int dxLo = dy == 0 ? 1 : -r;
-      if (dxLo > r) continue;
+    for (int dy = 0; dy <= reach; dy += step) {
+      const int dxLo = dy == 0 ? step : -reach;
+      if (dxLo > reach) continue;
       for (int sy = y0 - dy; sy < y1; ++sy) {
         const int slot = (sy - (y0 - dy)) % (dy + 1);
-        for (int dx = dxLo; dx <= r; ++dx) {
+        for (int dx = dxLo; dx <= reach; dx += step) {
           // Kernel row s is read at columns x0 − max(dx, 0) … x0 + width + max(−dx, 0) − 1;
           // pairs with s and s + δ in the image are evaluated, the rest is 0.
           float* row = k.data() + size_t(dx + r) * tile.kernelPlane + size_t(slot) * size_t(stride);

@@ -16,6 +16,7 @@ namespace chorus {
 
 struct BilateralKernel {
   int radius = 7;
+  int step = 1;  // offsets on a grid of this spacing only (|δ|∞ ≤ radius): a sparse wide window
   float kSpatial = 0;  // 1 / (2σ²) of each term; 0 disables it
   float kNormal = 0;
   float kAlbedo = 0;

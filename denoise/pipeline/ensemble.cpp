@@ -115,6 +115,13 @@ bool blendsFullRuns(int width, int height, double samplesPerPixel) {
   return long(width) * long(height) >= kFullRunPixels && samplesPerPixel <= kFullRunSpp;
 }
 
+CombineOptions optionsForRuns(CombineOptions options, const BaseRuns& runs,
+                              std::span<const EnsembleMember> members) {
+  if (runs.full && runs.heldOut && splitsNeeded(members) == 4)
+    options.mse.windowRadius = options.mse.fullRunWindowRadius;
+  return options;
+}
+
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
                                           std::vector<StageTime>* times, BaseRuns runs) {
@@ -214,7 +221,8 @@ EnsembleResult Ensemble::run(const EnsembleSources& sources, const Image* refere
   const BaseRuns runs = baseRunsFor(options_.mse, sources);
   result.bases = runBaseDenoisers(sources, members_, &result.times, runs);
   result.guides = guidesFromSources(sources, runs.heldOut);
-  result.combined = combine(result.guides, pointersTo(result.bases), options_, reference);
+  result.combined = combine(result.guides, pointersTo(result.bases),
+                            optionsForRuns(options_, runs, members_), reference);
   result.times.insert(result.times.end(), result.combined.times.begin(),
                       result.combined.times.end());
   return result;

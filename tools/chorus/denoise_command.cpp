@@ -123,6 +123,8 @@ void checkFeaturesHeld(const ReadInput& input, const std::vector<EnsembleMember>
 struct MemberRuns {
   std::vector<BaseOutputs> bases;  // alone: only `full` is set
   std::vector<StageTime> times;
+  std::vector<EnsembleMember> members;  // empty for an outputs directory
+  BaseRuns used;                        // the runs in `bases` (optionsForRuns)
 };
 
 // --combine none: each member alone on the full buffer (an outputs directory's full outputs are
@@ -159,7 +161,8 @@ MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& spec
     *guides = std::move(input.outputs->guides);
     return runs;
   }
-  const std::vector<EnsembleMember> members = fileSafeMembers(specs);
+  runs.members = fileSafeMembers(specs);
+  const std::vector<EnsembleMember>& members = runs.members;
   checkFeaturesHeld(input, members, true);
   EnsembleSources sources;
   try {
@@ -171,9 +174,9 @@ MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& spec
   } catch (const Error& e) {
     throw fileError(input.path, e.what() + inputHint(input, false));
   }
-  const BaseRuns needed = baseRunsFor(mse, sources);
-  runs.bases = runBaseDenoisers(sources, members, &runs.times, needed);
-  *guides = guidesFromSources(sources, needed.heldOut);
+  runs.used = baseRunsFor(mse, sources);
+  runs.bases = runBaseDenoisers(sources, members, &runs.times, runs.used);
+  *guides = guidesFromSources(sources, runs.used.heldOut);
   return runs;
 }
 
@@ -274,7 +277,7 @@ void runDenoise(const DenoiseArgs& args) {
   std::vector<std::string> written;
   std::vector<LeftOut> leftOut;
   for (size_t k = 0; k < combiners.size(); ++k) {
-    CombineOptions o = options;
+    CombineOptions o = optionsForRuns(options, runs.used, runs.members);
     o.combiner = combiners[k];
     const std::string name(combinerName(o.combiner));
     const CombineResult result =

@@ -24,9 +24,10 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
       ->capture_default_str();
   cmd.add_option("--window", window,
                  "Radius of the feature-guided window the MSE estimate is accumulated over "
-                 "(0 = per pixel, as in the paper)")
-      ->capture_default_str()
-      ->transform(integerIn(0, kMaxWindowRadius));
+                 "(0 = per pixel, as in the paper; default 5, and 15 where the blend takes "
+                 "full runs of members that split their input: large renders at <= 16 spp)")
+      ->transform(integerIn(0, kMaxWindowRadius))
+      ->each([this](const std::string&) { windowGiven = true; });
   cmd.add_flag("--relative,!--absolute", relative,
                "Divide the MSE estimate by (mean² + 0.01) so that it targets relMSE");
   cmd.add_option("--outlier-cap", outlierCap,
@@ -87,6 +88,7 @@ CombineOptions EnsembleFlags::options() const {
     throw Error("unknown --estimate '" + estimate + "' (known: halves, quarters, extrapolated)");
   // The numbers were range-checked when the flags were parsed (addFlags).
   o.mse.windowRadius = window;
+  if (windowGiven) o.mse.fullRunWindowRadius = window;  // one radius everywhere
   o.mse.relative = relative;
   o.mse.outlierCap = outlierCap;
   o.mse.consistency = consistency;

@@ -53,6 +53,7 @@ nlohmann::ordered_json combineOptionsJson(const CombineOptions& o) {
           {"mse", o.mse.form == MseForm::Summed ? "summed" : "per-channel"},
           {"estimate", estimateName(o.mse.estimate)},
           {"window", o.mse.windowRadius},
+          {"full_run_window", o.mse.fullRunWindowRadius},
           {"relative", o.mse.relative},
           {"outlier_cap", o.mse.outlierCap},
           {"consistency", o.mse.consistency},

@@ -43,6 +43,18 @@ struct Args {
   cli::EnsembleFlags ensemble;
 };
 
+// The members of `specs` that the registry knows: the synthetic entries' filters (box3, gauss3,
+// median5: tests/support/synthetic_cases.h) are not in it, and filter their whole input.
+std::vector<EnsembleMember> registeredMembers(const std::vector<std::string>& specs) {
+  std::vector<std::string> known;
+  for (const std::string& spec : specs) {
+    const std::string name = spec.substr(0, spec.find(':'));
+    for (const DenoiserEntry& entry : builtinDenoisers())
+      if (entry.name == name) known.push_back(spec);
+  }
+  return membersFromSpecs(known);
+}
+
 // The rows of one case: noisy, every member, every combination × combiner.
 std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir, int spp,
                                       const std::vector<std::string>& methods,
@@ -64,11 +76,18 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
       sweep::measuredRow(args.name, spp, "noisy", "-", 0, guides.color, reference, 0, 0)};
   for (const std::string& m : methods)
     rows.push_back(sweep::measuredRow(args.name, spp, m, "-", 1, alone[m], reference, 0, 0));
+  // What the blends take, as the pipeline decides it (optionsForRuns).
+  BaseRuns blended;
+  blended.heldOut = !outputs.empty() && outputs.begin()->second.heldOut.size() == 4;
+  blended.full = !(args.fullFromHeldOut && blended.heldOut &&
+                   !blendsFullRuns(guides.width(), guides.height(), spp));
   for (const std::string& combo : combos) {
     std::vector<const BaseOutputs*> chosen;
-    for (const std::string& m : sweep::splitCombination(combo)) chosen.push_back(&outputs.at(m));
+    const std::vector<std::string> specs = sweep::splitCombination(combo);
+    for (const std::string& m : specs) chosen.push_back(&outputs.at(m));
+    const CombineOptions forRuns = optionsForRuns(base, blended, registeredMembers(specs));
     for (const std::string& name : splitMethodList(args.combiners)) {
-      CombineOptions options = base;
+      CombineOptions options = forRuns;
       options.combiner = parseCombiner(name);
       const CombineResult result = combine(guides, chosen, options, &reference);
       double seconds = 0;

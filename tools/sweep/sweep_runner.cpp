@@ -203,6 +203,7 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
   // A member alone is its full run (what a user running only it gets), so the sweep always runs
   // it; the ensemble blends what `chorus render` blends (the held-out runs' mean, when it does).
   const bool blendsHeldOutMeans = !runs.full;
+  const BaseRuns blended = runs;  // what the ensemble's weights blend (optionsForRuns)
   runs.full = true;
   std::vector<BaseOutputs> bases = runBaseDenoisers(sources, plan.members, &times, runs);
   std::vector<Image> alone;  // each member's full run, for its own row
@@ -243,13 +244,16 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
 
   for (size_t i = 0; i < plan.combos.size(); ++i) {
     std::vector<const BaseOutputs*> members;
+    std::vector<EnsembleMember> memberDenoisers;
     double membersSeconds = 0;
     for (const std::string& m : splitCombination(plan.combos[i])) {
       members.push_back(byName.at(m));
       membersSeconds += ensembleCost.at(m);
+      for (const EnsembleMember& e : plan.members)
+        if (e.label == m) memberDenoisers.push_back(e);
     }
     for (Combiner combiner : plan.combiners) {
-      CombineOptions combineOptions = config.combine;
+      CombineOptions combineOptions = optionsForRuns(config.combine, blended, memberDenoisers);
       combineOptions.combiner = combiner;
       const CombineResult combined =
           combine(guides, members, combineOptions, needsReference(combiner) ? &reference : nullptr);

@@ -224,6 +224,60 @@ TEST(EnsembleCombiners, NeverDarkerThanEveryMemberWhereTheNoisyHalvesMissedTheLi
   EXPECT_GT(darkerThanEveryMember(combine(guides, pointersTo(bases), oldFallback)), 0);
 }
 
+// The member fallback (the previews' safeguard, K = 2): beside a light, one member spreads it onto
+// a dark, well-measured column (6 where both noisy halves say 0.05), another less (1); everywhere
+// else the spreading member is exact and the other 10 % off, so every window favours the
+// spreading one. With the tests that veto a member off (plausibility, consistency), the blend
+// takes it on that column; the fallback takes the closer member there (one-hot, never the
+// noisy value) and changes nothing where the blend is plausible.
+TEST(EnsembleCombiners, MemberFallbackTakesTheCloserMemberWhereTheBlendIsFarOff) {
+  const int w = 32, h = 16, column = 23;
+  EnsembleGuides guides;
+  Image truth(w, h, 3, 0.05f);
+  for (int y = 0; y < h; ++y)
+    for (int x = column + 1; x < w; ++x)
+      for (int c = 0; c < 3; ++c) truth(x, y, c) = 50.0f;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<float> gauss(0.0f, 0.05f);
+  guides.colorA = guides.colorB = truth;
+  for (Image* half : {&guides.colorA, &guides.colorB})
+    for (size_t e = 0; e < half->size(); ++e) half->data()[e] *= 1.0f + gauss(rng);
+  guides.color = guides.colorA;
+  for (size_t e = 0; e < guides.color.size(); ++e)
+    guides.color.data()[e] = 0.5f * (guides.colorA.data()[e] + guides.colorB.data()[e]);
+  guides.albedo = Image(w, h, 3, 0.5f);
+  guides.normal = Image(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) guides.normal(x, y, 2) = 1.0f;
+  const auto member = [&](const std::string& name, float bias, float spread) {
+    Image out = truth;
+    for (size_t e = 0; e < out.size(); ++e) out.data()[e] *= bias;
+    for (int y = 0; y < h; ++y)
+      for (int c = 0; c < 3; ++c) out(column, y, c) = spread;
+    return BaseOutputs{name, out, out, out, {}};
+  };
+  const std::vector<BaseOutputs> bases = {member("closer", 1.1f, 1.0f),
+                                          member("spreading", 1.0f, 6.0f)};
+  CombineOptions off;
+  off.mse.plausibility = 0;
+  off.mse.consistency = 0;
+  CombineOptions on = off;
+  on.mse.memberFallback = 2;
+  const CombineResult without = combine(guides, pointersTo(bases), off);
+  const CombineResult with = combine(guides, pointersTo(bases), on);
+  EXPECT_EQ(without.memberFallbackPixels, 0u);
+  EXPECT_EQ(with.memberFallbackPixels, size_t(h));
+  for (int y = 0; y < h; ++y)
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_GT(without.image(column, y, c), 3.0f) << y;  // mostly the spreading member
+      EXPECT_EQ(with.image(column, y, c), 1.0f) << y;     // the closer member, not the noisy 0.05
+    }
+  // Away from the column (beyond the window's reach of it) nothing changes.
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < column - 12; ++x)
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(with.image(x, y, c), without.image(x, y, c)) << x;
+}
+
 // A small prepared case for the robustness tests.
 synthetic::PreparedCase smallCase(uint64_t seed = 3) {
   synthetic::Case c = synthetic::standardCases()[0];

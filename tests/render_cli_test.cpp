@@ -336,6 +336,13 @@ TEST(RenderCli, PreviewWritesOnlyThePngAndStats) {
   EXPECT_EQ(stats["denoise"]["weight_filter"], "none");
   EXPECT_EQ(stats["denoise"]["image_prior"], 0.0);
   EXPECT_EQ(stats["denoise"]["plausibility"], 4.0);
+  EXPECT_EQ(stats["denoise"]["member_fallback"], 2.0);  // previews' safeguard, unless given
+  const auto off = dir / "preview-off";
+  ASSERT_EQ(runChorus({"render", scene.string(), "--width", "24", "--preview", "--member-fallback",
+                       "0", "--out", off.string()})
+                .exitCode,
+            0);
+  EXPECT_EQ(readJson(off / "stats.json")["denoise"]["member_fallback"], 0.0);
 }
 
 TEST(InfoCli, SummarisesTheScene) {

@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
   options.spp = spp;
   options.threads = threads;
   CombineOptions previewOptions;
-  cli::applyPreviewDefaults(previewOptions, false, false);  // as `chorus render --preview`
+  cli::applyPreviewDefaults(previewOptions);  // as `chorus render --preview`
   const Ensemble ensemble(membersFromSpecs(splitMethodList(preview)), previewOptions);
   options.splits = splitsNeeded(ensemble.members());  // as `chorus render`
 

@@ -61,9 +61,11 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
       ->transform(zeroOrFiniteIn(1, kMaxEnsembleFactor));
   cmd.add_option("--member-fallback", memberFallback,
                  "Use the member closest to the noisy data where the blend's own error term "
-                 "exceeds K² times that member's plus the noise (0 = off, else at least 1)")
+                 "exceeds K² times that member's plus the noise (0 = off, else at least 1; "
+                 "previews: 2 unless given)")
       ->capture_default_str()
-      ->transform(zeroOrFiniteIn(1, kMaxEnsembleFactor));
+      ->transform(zeroOrFiniteIn(1, kMaxEnsembleFactor))
+      ->each([this](const std::string&) { memberFallbackGiven = true; });
   cmd.add_option("--solver-seed", seed, "Seed of the pairwise solver")
       ->capture_default_str()
       ->transform(anyUnsigned64());

@@ -24,6 +24,7 @@ struct EnsembleFlags {
 
   bool weightFilterGiven = false;  // --weight-filter was on the command line
   bool imagePriorGiven = false;    // --image-prior was on the command line
+  bool memberFallbackGiven = false;  // --member-fallback was on the command line
   bool windowGiven = false;        // --window was on the command line (no full-run radius)
 
   void addFlags(CLI::App& cmd);

@@ -50,7 +50,7 @@ DenoiseStage denoiseStageOf(const RenderArgs& args) {
   CombineOptions options = args.ensemble.options();
   options.combiner = parseCombiner(args.combine);
   if (args.preview)
-    applyPreviewDefaults(options, args.ensemble.weightFilterGiven, args.ensemble.imagePriorGiven);
+    applyPreviewDefaults(options, args.ensemble);
   const std::string list = args.denoiseGiven ? args.denoise : args.preview ? "preview" : "default";
   DenoiseStage stage = DenoiseStage::parse(list, options, !args.preview);
   stage.keep = args.keep;

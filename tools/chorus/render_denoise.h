@@ -12,6 +12,7 @@
 
 #include "denoise/ensemble/combiners.h"
 #include "denoise/pipeline/ensemble.h"
+#include "tools/chorus/ensemble_flags.h"
 #include "tools/chorus/kept_outputs.h"
 
 namespace chorus::cli {
@@ -22,15 +23,18 @@ inline constexpr const char* kDefaultDenoise = "nfor,rdfc,atrous";
 inline constexpr const char* kPreviewDenoise =
     "atrous:borrow=0.5,atrous:iterations=4:sigmaL=8:sigmaN=16:borrow=0.5";
 
-// The ensemble options previews change, each unless its flag was given: no weight filter (it
-// cost more than it gained at 4 spp) and no image prior (the two à-trous members differ by
-// detail, not by a ranking the whole image agrees on: cornell-box 512², 4 spp, relMSE 0.00505
-// without, 0.00511 with, and a pass over the image less). For `chorus render --preview` and
-// bench_preview alike.
-inline void applyPreviewDefaults(CombineOptions& options, bool weightFilterGiven,
-                                 bool imagePriorGiven) {
-  if (!weightFilterGiven) options.filter.enabled = false;
-  if (!imagePriorGiven) options.mse.imagePrior = 0;
+// The ensemble options previews change, each unless its flag was given (EnsembleFlags): no
+// weight filter (it cost more than it gained at 4 spp), no image prior (the two à-trous members
+// differ by detail, not by a ranking the whole image agrees on: cornell-box 512², 4 spp, relMSE
+// 0.00505 without, 0.00511 with, and a pass over the image less), and the member fallback at
+// K = 2 (where the blend's own error is 4× the best member's, that member: a permissive à-trous
+// spreading a light onto a dark, well-measured pixel held 79 % of a 512² preview's error;
+// docs/ensemble-quality.md). For `chorus render --preview` and bench_preview alike.
+inline constexpr double kPreviewMemberFallback = 2.0;
+inline void applyPreviewDefaults(CombineOptions& options, const EnsembleFlags& given = {}) {
+  if (!given.weightFilterGiven) options.filter.enabled = false;
+  if (!given.imagePriorGiven) options.mse.imagePrior = 0;
+  if (!given.memberFallbackGiven) options.mse.memberFallback = kPreviewMemberFallback;
 }
 
 struct DenoiseStage {

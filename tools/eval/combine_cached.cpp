@@ -124,8 +124,7 @@ void run(const Args& args) {
   const std::vector<std::string> combos = sweep::planCombinations(methods, args.combos);
   const CombineOptions options = args.ensemble.options();
   CombineOptions previewOptions = options;
-  cli::applyPreviewDefaults(previewOptions, args.ensemble.weightFilterGiven,
-                            args.ensemble.imagePriorGiven);
+  cli::applyPreviewDefaults(previewOptions, args.ensemble);
   const std::vector<int> previewSpps = sweep::parseIntList(args.previewSpp, "--preview-spp");
   std::vector<int> spps;
   if (!args.spp.empty()) {

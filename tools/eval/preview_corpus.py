@@ -17,6 +17,7 @@ from corpus import Paths, scene_flags
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--corpus", default=corpus_file.DEFAULT_CORPUS)
     parser.add_argument("--cache", default="build/eval-cache")
     parser.add_argument("--chorus", default="build/chorus")
     parser.add_argument("--out", required=True)
@@ -24,7 +25,7 @@ def main():
     parser.add_argument("--shared", default=os.environ.get("CHORUS_SHARED_DIR", "../shared"))
     parser.add_argument("flags", nargs="*")
     args = parser.parse_args()
-    corpus = json.load(open(corpus_file.DEFAULT_CORPUS))
+    corpus = json.load(open(args.corpus))
     # The cache keeps the generated scenes in CACHE/scenes, as cached_corpus.py does.
     paths = Paths(argparse.Namespace(out=args.out, shared=args.shared,
                                      scenes=os.path.join(args.cache, "scenes")))

@@ -152,6 +152,19 @@ TEST(EnsembleCombiners, NoisyFallbackWhereNoBaseIsPlausible) {
   EXPECT_TRUE(combine(p.guides, pointersTo(p.bases), average).noisyFallback.empty());
 }
 
+// The rest of the guides of a flat, featureless surface whose noisy halves are set: the full
+// buffer's mean of the halves, albedo 0.5, normals facing +z.
+void completeFlatGuides(EnsembleGuides& guides) {
+  const int w = guides.colorA.width(), h = guides.colorA.height();
+  guides.color = guides.colorA;
+  for (size_t e = 0; e < guides.color.size(); ++e)
+    guides.color.data()[e] = 0.5f * (guides.colorA.data()[e] + guides.colorB.data()[e]);
+  guides.albedo = Image(w, h, 3, 0.5f);
+  guides.normal = Image(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) guides.normal(x, y, 2) = 1.0f;
+}
+
 // The interior-at-4-spp pattern (issue 25): a bright region lit through one bounce, where some
 // pixels got no sample of the light in either half (x^A = x^B = 0) while every member has spread
 // the light there from the lit neighbours. The noisy value is the implausible one, so with the
@@ -178,13 +191,7 @@ TEST(EnsembleCombiners, NeverDarkerThanEveryMemberWhereTheNoisyHalvesMissedTheLi
         for (int c = 0; c < 3; ++c)
           (*half)(x, y, c) = missed ? 0.0f : std::max(0.0f, truth(x, y, c) * (1.0f + gauss(rng)));
     }
-  guides.color = guides.colorA;
-  for (size_t e = 0; e < guides.color.size(); ++e)
-    guides.color.data()[e] = 0.5f * (guides.colorA.data()[e] + guides.colorB.data()[e]);
-  guides.albedo = Image(w, h, 3, 0.5f);
-  guides.normal = Image(w, h, 3);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) guides.normal(x, y, 2) = 1.0f;
+  completeFlatGuides(guides);
   const auto box = [&](const Image& in, int r) {
     Image out(w, h, 3);
     for (int y = 0; y < h; ++y)
@@ -242,13 +249,7 @@ TEST(EnsembleCombiners, MemberFallbackTakesTheCloserMemberWhereTheBlendIsFarOff)
   guides.colorA = guides.colorB = truth;
   for (Image* half : {&guides.colorA, &guides.colorB})
     for (size_t e = 0; e < half->size(); ++e) half->data()[e] *= 1.0f + gauss(rng);
-  guides.color = guides.colorA;
-  for (size_t e = 0; e < guides.color.size(); ++e)
-    guides.color.data()[e] = 0.5f * (guides.colorA.data()[e] + guides.colorB.data()[e]);
-  guides.albedo = Image(w, h, 3, 0.5f);
-  guides.normal = Image(w, h, 3);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) guides.normal(x, y, 2) = 1.0f;
+  completeFlatGuides(guides);
   const auto member = [&](const std::string& name, float bias, float spread) {
     Image out = truth;
     for (size_t e = 0; e < out.size(); ++e) out.data()[e] *= bias;

@@ -161,8 +161,8 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
         const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
         const double weight = channelWeight(qx, qy, c);
         for (const BaseOutputs& b : f.bases)
-          trace += weight * 0.5 *
-                   (std::pow(b.a(qx, qy, c) - xB, 2) + std::pow(b.b(qx, qy, c) - xA, 2));
+          trace +=
+              weight * 0.5 * (std::pow(b.a(qx, qy, c) - xB, 2) + std::pow(b.b(qx, qy, c) - xA, 2));
       }
       cap = o.outlierCap / (trace / unit + o.outlierCap);
     }

@@ -201,13 +201,13 @@ TEST(EnsembleRunner, FullRunsOfMembersThatSplitTheirInputGetTheWiderWindow) {
       const bool wide = split && perQuarter == 1;
       const MseOptions defaults;
       ASSERT_NE(defaults.windowRadius, defaults.fullRunWindowRadius);
-      EXPECT_TRUE(sameImage(result.combined.image,
-                            blendWith(result, wide ? defaults.fullRunWindowRadius
-                                                   : defaults.windowRadius)))
+      EXPECT_TRUE(
+          sameImage(result.combined.image,
+                    blendWith(result, wide ? defaults.fullRunWindowRadius : defaults.windowRadius)))
           << perQuarter << " " << split;
-      EXPECT_FALSE(sameImage(result.combined.image,
-                             blendWith(result, wide ? defaults.windowRadius
-                                                    : defaults.fullRunWindowRadius)))
+      EXPECT_FALSE(
+          sameImage(result.combined.image,
+                    blendWith(result, wide ? defaults.windowRadius : defaults.fullRunWindowRadius)))
           << perQuarter << " " << split;
     }
   }

@@ -45,12 +45,13 @@ bool finite3(const float* v) {
   return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
 }
 
-// Index of (i, j), i ≤ j, in the packed upper triangle of an n × n matrix.
 // The window's tap spacing: dense up to radius 8, every third pixel beyond, over 3 × 3 box means
 // of the terms (boxMeans), so that the radius-15 window costs what a radius-5 one does (and, on
 // the 256- and 512-px corpora, blends better than the dense radius-15 window:
 // docs/ensemble-quality.md).
-int windowStep(int radius) { return radius > 8 ? 3 : 1; }
+int windowStep(int radius) {
+  return radius > 8 ? 3 : 1;
+}
 
 // Per plane (`planes` planes of `rows` rows × width), the mean over the (2b + 1)² box around each
 // pixel, clipped to the planes' rows and columns.
@@ -79,6 +80,7 @@ std::vector<float> boxMeans(const std::vector<float>& in, int planes, int rows, 
   return out;
 }
 
+// Index of (i, j), i ≤ j, in the packed upper triangle of an n × n matrix.
 int packed(int i, int j, int n) {
   return i * n - i * (i - 1) / 2 + (j - i);
 }

@@ -22,10 +22,10 @@ struct EnsembleFlags {
   double memberFallback = MseOptions{}.memberFallback;
   uint64_t seed = 1;
 
-  bool weightFilterGiven = false;  // --weight-filter was on the command line
-  bool imagePriorGiven = false;    // --image-prior was on the command line
+  bool weightFilterGiven = false;    // --weight-filter was on the command line
+  bool imagePriorGiven = false;      // --image-prior was on the command line
   bool memberFallbackGiven = false;  // --member-fallback was on the command line
-  bool windowGiven = false;        // --window was on the command line (no full-run radius)
+  bool windowGiven = false;          // --window was on the command line (no full-run radius)
 
   void addFlags(CLI::App& cmd);
   // Throws chorus::Error for an unknown value.

@@ -49,8 +49,7 @@ struct RenderArgs {
 DenoiseStage denoiseStageOf(const RenderArgs& args) {
   CombineOptions options = args.ensemble.options();
   options.combiner = parseCombiner(args.combine);
-  if (args.preview)
-    applyPreviewDefaults(options, args.ensemble);
+  if (args.preview) applyPreviewDefaults(options, args.ensemble);
   const std::string list = args.denoiseGiven ? args.denoise : args.preview ? "preview" : "default";
   DenoiseStage stage = DenoiseStage::parse(list, options, !args.preview);
   stage.keep = args.keep;

@@ -223,6 +223,15 @@ TEST(GuardedDenoiser, RegistryMembersKeepTheirNamesAndRequirements) {
     EXPECT_EQ(guarded->requirements().features, plain->requirements().features);
   }
   EXPECT_THROW(createDenoiser("atrous:guard=-1"), Error);
+  EXPECT_NO_THROW(createDenoiser("atrous:spread=12"));
+  for (const char* bad : {"atrous:spread=0", "atrous:spread=33"}) {
+    try {
+      createDenoiser(bad);
+      ADD_FAILURE() << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("spread must be"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(OutputValues, RepairsAndCounts) {

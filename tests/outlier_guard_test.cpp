@@ -127,6 +127,29 @@ TEST(OutlierGuard, FirefliesWithPeersKeepTheirEnergy) {
   EXPECT_LT(largest, 0.2f * 300.0f / 4.0f);
 }
 
+// spread=R (the previews take 12): the same caustic's excess over a wider window keeps the same
+// energy in a fainter, wider blob.
+TEST(OutlierGuard, AWiderSpreadKeepsTheEnergyInAFainterBlob) {
+  const SubBuffer s = fromSamples(40, 40, [](int x, int y) {
+    std::vector<double> v = ordinary(x, y, 4);
+    if (x >= 12 && x < 28 && y >= 12 && y < 28 && (3 * x + 5 * y) % 11 == 0) v[0] = 300.0;
+    return v;
+  });
+  OutlierGuardOptions wide;
+  wide.spreadRadius = 12;
+  const Image narrowOut = guardOutliers(wholeOnly(s)).input.whole.color.mean;
+  const Image wideOut = guardOutliers(wholeOnly(s), wide).input.whole.color.mean;
+  const double before = channelSum(s.color.mean);
+  EXPECT_NEAR(channelSum(wideOut), before, 1e-5 * before);
+  float narrowPeak = 0, widePeak = 0;
+  for (float v : narrowOut.values()) narrowPeak = std::max(narrowPeak, v);
+  for (float v : wideOut.values()) widePeak = std::max(widePeak, v);
+  EXPECT_LT(widePeak, 0.8f * narrowPeak);
+  // Nine pixels left of the block: beyond radius 6 of every outlier, within 12 of some.
+  EXPECT_EQ(narrowOut(3, 20, 0), s.color.mean(3, 20, 0));
+  EXPECT_GT(wideOut(3, 20, 0), s.color.mean(3, 20, 0));
+}
+
 // The caustic of FirefliesWithPeersKeepTheirEnergy on a surface that ends at x = 20; beyond it
 // every sample misses a black background.
 SubBuffer causticUpToAnEdge(float backgroundDepth) {

@@ -34,13 +34,15 @@
 
 namespace chorus {
 
+inline constexpr int kMaxGuardSpread = 32;
+
 struct OutlierGuardOptions {
   int radius = 2;
   float ceilingSigmas = 8.0f;  // 0: the guard is off
   float highFactor = 4.0f;
   float confirmSigmas = 2.5f;
   float peerSigmas = 6.0f;
-  int spreadRadius = 6;
+  int spreadRadius = 6;  // a member spec's spread=R (1 … kMaxGuardSpread)
   bool operator==(const OutlierGuardOptions&) const = default;
 };
 

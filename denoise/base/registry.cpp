@@ -63,6 +63,10 @@ std::unique_ptr<BaseDenoiser> createDenoiser(const std::string& spec) {
       guard.ceilingSigmas = params.getFloat("guard", guard.ceilingSigmas);
       if (!(guard.ceilingSigmas >= 0.0f))
         throw Error("guard must be 0 (off) or a positive number of standard deviations");
+      guard.spreadRadius = params.getInt("spread", guard.spreadRadius);
+      if (guard.spreadRadius < 1 || guard.spreadRadius > kMaxGuardSpread)
+        throw Error("spread must be a radius of 1 … " + std::to_string(kMaxGuardSpread) +
+                    " pixels");
       denoiser = std::make_unique<GuardedDenoiser>(entry.create(params), guard);
     } catch (const Error& e) {  // a bad value: say which denoiser it was for
       throw Error("denoiser " + name + ": " + e.what());

@@ -20,8 +20,11 @@ namespace chorus::cli {
 // The members `chorus render` uses when --denoise is not given, and with --preview (README,
 // "Choosing the default members": the sweep evidence behind both).
 inline constexpr const char* kDefaultDenoise = "nfor,rdfc,atrous";
+// The previews' members spread an unconfirmed outlier's excess over a radius of 12 instead of 6
+// (the guard's spread=R): at 4 samples per pixel a caustic's one bright sample is a poor guide to
+// where its energy belongs, and a wider spread leaves a fainter blob (docs/ensemble-quality.md).
 inline constexpr const char* kPreviewDenoise =
-    "atrous:borrow=0.5,atrous:iterations=4:sigmaL=8:sigmaN=16:borrow=0.5";
+    "atrous:borrow=0.5:spread=12,atrous:iterations=4:sigmaL=8:sigmaN=16:borrow=0.5:spread=12";
 
 // The ensemble options previews change, each unless its flag was given (EnsembleFlags): no
 // weight filter (it cost more than it gained at 4 spp), no image prior (the two à-trous members

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "common/error.h"
+#include "denoise/base/filters/box_filter.h"
 #include "denoise/metrics/metrics.h"
 
 namespace chorus {
@@ -46,38 +47,11 @@ bool finite3(const float* v) {
 }
 
 // The window's tap spacing: dense up to radius 8, every third pixel beyond, over 3 × 3 box means
-// of the terms (boxMeans), so that the radius-15 window costs what a radius-5 one does (and, on
-// the 256- and 512-px corpora, blends better than the dense radius-15 window:
+// of the terms (boxFilterPlane), so that the radius-15 window costs what a radius-5 one does
+// (and, on the 256- and 512-px corpora, blends better than the dense radius-15 window:
 // docs/ensemble-quality.md).
 int windowStep(int radius) {
   return radius > 8 ? 3 : 1;
-}
-
-// Per plane (`planes` planes of `rows` rows × width), the mean over the (2b + 1)² box around each
-// pixel, clipped to the planes' rows and columns.
-std::vector<float> boxMeans(const std::vector<float>& in, int planes, int rows, int width, int b) {
-  const size_t pixels = size_t(rows) * size_t(width);
-  std::vector<float> horizontal(pixels), out(size_t(planes) * pixels);
-  for (int k = 0; k < planes; ++k) {
-    const float* src = in.data() + size_t(k) * pixels;
-    for (int y = 0; y < rows; ++y)
-      for (int x = 0; x < width; ++x) {
-        const int x0 = std::max(0, x - b), x1 = std::min(width - 1, x + b);
-        float sum = 0;
-        for (int q = x0; q <= x1; ++q) sum += src[size_t(y) * size_t(width) + size_t(q)];
-        horizontal[size_t(y) * size_t(width) + size_t(x)] = sum / float(x1 - x0 + 1);
-      }
-    float* dst = out.data() + size_t(k) * pixels;
-    for (int y = 0; y < rows; ++y) {
-      const int y0 = std::max(0, y - b), y1 = std::min(rows - 1, y + b);
-      for (int x = 0; x < width; ++x) {
-        float sum = 0;
-        for (int q = y0; q <= y1; ++q) sum += horizontal[size_t(q) * size_t(width) + size_t(x)];
-        dst[size_t(y) * size_t(width) + size_t(x)] = sum / float(y1 - y0 + 1);
-      }
-    }
-  }
-  return out;
 }
 
 // Index of (i, j), i ≤ j, in the packed upper triangle of an n × n matrix.
@@ -616,7 +590,8 @@ MseRows MseEstimator::rows(int y0, int y1) const {
   // pixels with both present: the window's mean over the pixels that have the entry (exact
   // where one base has holes, an approximation where several have different ones).
   // A sparse window's taps read box means (below): half a box more of halo.
-  const int halo = r + windowStep(r) / 2;
+  const int step = windowKernel_.step;
+  const int halo = r + step / 2;
   const int inY0 = std::max(0, y0 - halo), inY1 = std::min(height_, y1 + halo);
   std::vector<float> in;
   const std::vector<BaseMask> present = pixelTerms(inY0, inY1, in, objectiveEpsilon());
@@ -644,13 +619,13 @@ MseRows MseEstimator::rows(int y0, int y1) const {
     outPlanes.push_back(k < planeCount() ? out.planes_.data() + size_t(k) * pixels
                                          : outPresence.data() + size_t(k - planeCount()) * pixels);
   }
-  std::vector<float> boxed;
-  if (windowStep(r) > 1) {
-    // Taps every `step` pixels over step × step box means of the terms: as many pixels' terms
-    // as the dense window averages, at 1/step² of its taps.
-    boxed = boxMeans(in, planeCount() + presencePlanes, inY1 - inY0, width_, windowStep(r) / 2);
+  if (step > 1) {
+    // Taps every `step` pixels over step × step box means of the terms (in place): as many
+    // pixels' terms as the dense window averages, at 1/step² of its taps.
+    std::vector<float> scratch;
     for (int k = 0; k < planeCount() + presencePlanes; ++k)
-      inPlanes[size_t(k)] = boxed.data() + size_t(k) * inPixels;
+      boxFilterPlane(in.data() + size_t(k) * inPixels, in.data() + size_t(k) * inPixels, width_,
+                     inY1 - inY0, step / 2, scratch);
   }
   filterPlaneRows(windowGuides_, windowKernel_, inPlanes, inY0, y0, y1, outPlanes);
   if (holes) {

@@ -68,19 +68,19 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
     BaseOutputs& o = outputs[m] = readCachedMember(caseDir, m);
     alone[m] = o.full;
     if (args.noHalfRuns && o.heldOut.size() == 4) o.a = o.b = Image();
-    if (args.fullFromHeldOut && o.heldOut.size() == 4 &&
-        !blendsFullRuns(guides.width(), guides.height(), spp))
-      o.full = meanOfHeldOutRuns(o);
   }
-  std::vector<sweep::SweepRow> rows = {
-      sweep::measuredRow(args.name, spp, "noisy", "-", 0, guides.color, reference, 0, 0)};
-  for (const std::string& m : methods)
-    rows.push_back(sweep::measuredRow(args.name, spp, m, "-", 1, alone[m], reference, 0, 0));
-  // What the blends take, as the pipeline decides it (optionsForRuns).
+  // What the blends take, as the pipeline decides it (baseRunsFor, optionsForRuns): a case's
+  // members all have their held-out runs or none.
   BaseRuns blended;
   blended.heldOut = !outputs.empty() && outputs.begin()->second.heldOut.size() == 4;
   blended.full = !(args.fullFromHeldOut && blended.heldOut &&
                    !blendsFullRuns(guides.width(), guides.height(), spp));
+  if (!blended.full)
+    for (auto& [name, o] : outputs) o.full = meanOfHeldOutRuns(o);
+  std::vector<sweep::SweepRow> rows = {
+      sweep::measuredRow(args.name, spp, "noisy", "-", 0, guides.color, reference, 0, 0)};
+  for (const std::string& m : methods)
+    rows.push_back(sweep::measuredRow(args.name, spp, m, "-", 1, alone[m], reference, 0, 0));
   for (const std::string& combo : combos) {
     std::vector<const BaseOutputs*> chosen;
     const std::vector<std::string> specs = sweep::splitCombination(combo);

@@ -203,8 +203,8 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
   BaseRuns runs = baseRunsFor(config.combine.mse, sources);
   // A member alone is its full run (what a user running only it gets), so the sweep always runs
   // it; the ensemble blends what `chorus render` blends (the held-out runs' mean, when it does).
-  const bool blendsHeldOutMeans = !runs.full;
   const BaseRuns blended = runs;  // what the ensemble's weights blend (optionsForRuns)
+  const bool blendsHeldOutMeans = !blended.full;
   runs.full = true;
   std::vector<BaseOutputs> bases = runBaseDenoisers(sources, plan.members, &times, runs);
   std::vector<Image> alone;  // each member's full run, for its own row
@@ -218,10 +218,10 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
   // shared across combinations here, but a user running that one ensemble pays all of it. Runs
   // are timed individually, so the figures are sequential costs even though the sweep runs the
   // bases in parallel.
-  std::map<std::string, const BaseOutputs*> byName;
+  std::map<std::string, size_t> indexOf;       // member → its index in bases and plan.members
   std::map<std::string, double> ensembleCost;  // member → every run of it the ensemble uses
   for (const BaseOutputs& b : bases) {
-    byName[b.name] = &b;
+    indexOf[b.name] = size_t(&b - bases.data());
     for (const StageTime& t : times)
       if (t.stage.rfind(b.name + "/", 0) == 0 &&
           !(blendsHeldOutMeans && t.stage == b.name + "/full"))
@@ -248,10 +248,9 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
     std::vector<EnsembleMember> memberDenoisers;
     double membersSeconds = 0;
     for (const std::string& m : splitCombination(plan.combos[i])) {
-      members.push_back(byName.at(m));
+      members.push_back(&bases[indexOf.at(m)]);
+      memberDenoisers.push_back(plan.members[indexOf.at(m)]);
       membersSeconds += ensembleCost.at(m);
-      for (const EnsembleMember& e : plan.members)
-        if (e.label == m) memberDenoisers.push_back(e);
     }
     for (Combiner combiner : plan.combiners) {
       CombineOptions combineOptions = optionsForRuns(config.combine, blended, memberDenoisers);

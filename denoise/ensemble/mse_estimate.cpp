@@ -84,15 +84,15 @@ void MseRows::pixel(int x, int y, PixelMse& out) const {
     h.resize(n, n);
     int e = 0;
     for (int i = 0; i < n; ++i)
-      for (int j = i; j < n; ++j, ++e) h(i, j) = h(j, i) = plane[size_t(e) * pixels] * unitAt(p);
-    out.constant[size_t(g)] = plane[size_t(entries_) * pixels] * unitAt(p);
+      for (int j = i; j < n; ++j, ++e) h(i, j) = h(j, i) = plane[size_t(e) * pixels] * unit_;
+    out.constant[size_t(g)] = plane[size_t(entries_) * pixels] * unit_;
   }
 }
 
 double MseRows::diagonal(int x, int y, int group, int base) const {
   const size_t pixels = size_t(y1_ - y0_) * size_t(width_);
   const size_t plane = size_t(group * (entries_ + 1) + packed(base, base, baseCount_));
-  return planes_[plane * pixels + index(x, y)] * unitAt(index(x, y));
+  return planes_[plane * pixels + index(x, y)] * unit_;
 }
 
 MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOutputs* const> bases,
@@ -178,7 +178,6 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
   scale_ = count > 0 ? sum / double(count) : 1.0;
   if (!(scale_ > 0.0) || !std::isfinite(scale_ * scale_) || !std::isfinite(1.0 / (scale_ * scale_)))
     scale_ = 1.0;
-  if (options.localScale && !reference) computeLocalScale(guides);
 
   if (options.windowRadius > 0) {
     const float sigmaSpatial =
@@ -209,7 +208,7 @@ void MseEstimator::addPriorRow(int y, std::vector<float>& planes, std::vector<do
   const int n = baseCount_, entries = this->entries();
   // Relative to μ̂² + (mean |x| / 2)²: every region counts by its relative error, as in relMSE,
   // but with a knee that follows the image's brightness, not its unit.
-  const std::vector<BaseMask> present = pixelTerms(y, y + 1, planes, TermUnits::Prior);
+  const std::vector<BaseMask> present = pixelTerms(y, y + 1, planes, 0.25 * scale_ * scale_);
   const size_t pixels = present.size();
   for (size_t p = 0; p < pixels; ++p) {
     const BaseMask mask = present[p];
@@ -285,44 +284,8 @@ void MseEstimator::addImagePrior(MseRows& rows) const {
   }
 }
 
-MseEstimator::TermUnits MseEstimator::objectiveUnits() const {
-  return options_.relative ? TermUnits::Relative : TermUnits::Absolute;
-}
-
-void MseEstimator::computeLocalScale(const EnsembleGuides& guides) {
-  // Mean |x| of the noisy halves per pixel, then its mean over the window's square (direct
-  // sums in double: running sums would carry a bright region's rounding into a dim one).
-  const size_t pixels = size_t(width_) * size_t(height_);
-  std::vector<double> level(pixels, 0.0), count(pixels, 0.0);
-  for (size_t p = 0; p < pixels; ++p)
-    for (const Image* image : {&guides.colorA, &guides.colorB})
-      for (int c = 0; c < 3; ++c) {
-        const float v = image->data()[p * 3 + size_t(c)];
-        if (std::isfinite(v)) level[p] += std::abs(double(v)), count[p] += 1;
-      }
-  const int r = std::max(1, options_.windowRadius);
-  auto boxPass = [&](std::vector<double>& values, bool vertical) {
-    std::vector<double> out(pixels, 0.0);
-    tbb::parallel_for(0, height_, [&](int y) {
-      for (int x = 0; x < width_; ++x) {
-        double sum = 0;
-        for (int d = -r; d <= r; ++d) {
-          const int xx = vertical ? x : x + d, yy = vertical ? y + d : y;
-          if (xx >= 0 && xx < width_ && yy >= 0 && yy < height_)
-            sum += values[size_t(yy) * size_t(width_) + size_t(xx)];
-        }
-        out[size_t(y) * size_t(width_) + size_t(x)] = sum;
-      }
-    });
-    values = std::move(out);
-  };
-  for (bool vertical : {false, true}) boxPass(level, vertical), boxPass(count, vertical);
-  localScale_.resize(pixels);
-  for (size_t p = 0; p < pixels; ++p) {
-    const double s = count[p] > 0 ? level[p] / count[p] : 0.0;
-    const bool usable = s > 0 && std::isfinite(s * s) && std::isfinite(1.0 / (s * s));
-    localScale_[p] = usable ? s : scale_;
-  }
+double MseEstimator::objectiveEpsilon() const {
+  return options_.relative ? kRelMseEpsilon : -1.0;
 }
 
 BaseMask MseEstimator::validAt(size_t pixel) const {
@@ -403,7 +366,6 @@ std::vector<int> MseEstimator::memberFallbacks(std::span<const Image> weights) c
 
 BaseMask MseEstimator::consistentBases(size_t pixel, BaseMask mask) const {
   const size_t e = pixel * 3;
-  const double scale = scaleAt(pixel);
   BaseMask consistent = 0;
   for (int i = 0; i < baseCount_; ++i) {
     if (!((mask >> i) & 1u)) continue;
@@ -419,7 +381,7 @@ BaseMask MseEstimator::consistentBases(size_t pixel, BaseMask mask) const {
       const double full = outFull_[size_t(i)][e + size_t(c)];
       close =
           close && std::abs(full - mean) <= options_.consistency * 0.5 * (high - low) +
-                                                kConsistencyAllowance * (scale + std::abs(mean));
+                                                kConsistencyAllowance * (scale_ + std::abs(mean));
     }
     if (close) consistent |= BaseMask(1) << i;
   }
@@ -451,7 +413,6 @@ double MseEstimator::comparatorNoise(const std::vector<Fold>& folds, size_t ec) 
 
 MseEstimator::FoldTerms MseEstimator::foldTermsAt(size_t pixel, BaseMask mask) const {
   const size_t e = pixel * 3;
-  const double scale = scaleAt(pixel);
   FoldTerms t;
   t.folds = int(folds_.size());
   for (int c = 0; c < 3; ++c) {
@@ -459,11 +420,11 @@ MseEstimator::FoldTerms MseEstimator::foldTermsAt(size_t pixel, BaseMask mask) c
     double mean = 0;
     for (size_t f = 0; f < folds_.size(); ++f) {
       const double x = folds_[f].comparator[ec];
-      const double floor = kConsistencyAllowance * (scale + std::abs(x));
+      const double floor = kConsistencyAllowance * (scale_ + std::abs(x));
       t.floor[f] += floor * floor;
       mean += x / double(folds_.size());
     }
-    const double fMean = kConsistencyAllowance * (scale + std::abs(mean));
+    const double fMean = kConsistencyAllowance * (scale_ + std::abs(mean));
     t.floorMean += fMean * fMean;
     t.noise += comparatorNoise(ec);
   }
@@ -521,8 +482,8 @@ BaseMask MseEstimator::plausibleBases(BaseMask mask, const FoldTerms& t) const {
 }
 
 std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes,
-                                               TermUnits units) const {
-  const bool relative = units != TermUnits::Absolute;
+                                               double relativeEpsilon) const {
+  const bool relative = relativeEpsilon >= 0;
   const int n = baseCount_, entries = this->entries();
   const size_t pixels = size_t(y1 - y0) * size_t(width_);
   planes.assign(size_t(planeCount()) * pixels, 0.0f);
@@ -535,12 +496,9 @@ std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float
     if (reference_ ? !finite3(reference_ + e) : !comparatorsFinite(q)) continue;
     const BaseMask valid = validAt(q);
     std::fill(acc.begin(), acc.begin() + planeCount(), 0.0);
-    const double scale = scaleAt(q);
-    const double relativeEpsilon =
-        units == TermUnits::Prior ? 0.25 * scale * scale : kRelMseEpsilon;
     for (int c = 0; c < 3; ++c) {
       const size_t ec = e + size_t(c);
-      double weight = 1.0 / (scale * scale);
+      double weight = 1.0 / (scale_ * scale_);
       if (relative) {
         double mu = 0;
         int count = 0;
@@ -611,13 +569,6 @@ MseRows MseEstimator::rows(int y0, int y1) const {
   out.entries_ = entries();
   out.unit_ = options_.relative ? 1.0 : scale_ * scale_;
   const size_t pixels = size_t(y1 - y0) * size_t(width_);
-  if (!options_.relative && !localScale_.empty()) {
-    out.units_.resize(pixels);
-    for (size_t local = 0; local < pixels; ++local) {
-      const double scale = scaleAt(size_t(y0) * size_t(width_) + local);
-      out.units_[local] = scale * scale;
-    }
-  }
   out.valid_.resize(pixels);
   out.fallback_.resize(pixels);
   for (size_t local = 0; local < pixels; ++local) {
@@ -628,7 +579,7 @@ MseRows MseEstimator::rows(int y0, int y1) const {
 
   const int r = options_.windowRadius;
   if (r == 0) {
-    pixelTerms(y0, y1, out.planes_, objectiveUnits());
+    pixelTerms(y0, y1, out.planes_, objectiveEpsilon());
     addImagePrior(out);
     return out;
   }
@@ -643,7 +594,7 @@ MseRows MseEstimator::rows(int y0, int y1) const {
   const int halo = r + step / 2;
   const int inY0 = std::max(0, y0 - halo), inY1 = std::min(height_, y1 + halo);
   std::vector<float> in;
-  const std::vector<BaseMask> present = pixelTerms(inY0, inY1, in, objectiveUnits());
+  const std::vector<BaseMask> present = pixelTerms(inY0, inY1, in, objectiveEpsilon());
   const size_t inPixels = size_t(inY1 - inY0) * size_t(width_);
   const BaseMask all = allBases(baseCount_);
   const bool holes =

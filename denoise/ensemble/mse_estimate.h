@@ -122,9 +122,6 @@ struct MseOptions {
   double imagePrior = 0.3;
   double noisyFallback = 0.0;
   double memberFallback = 0.0;
-  // The unit of the absolute terms, the outlier cap's and the tests' allowances and the image
-  // prior's knee: the mean |x| over the pixel's window (true) or over the image (false).
-  bool localScale = false;
   float windowSigmaSpatial = 0;  // σ_s in pixels; 0 = the window radius
   float windowSigmaNormal = 0.2f;
   float windowSigmaAlbedo = 0.1f;
@@ -156,8 +153,6 @@ class MseRows {
   size_t index(int x, int y) const { return size_t(y - y0_) * size_t(width_) + size_t(x); }
   int y0_ = 0, y1_ = 0, width_ = 0, baseCount_ = 0, groups_ = 0, entries_ = 0;
   double unit_ = 1.0;          // stored value × unit = objective units
-  std::vector<double> units_;  // per pixel instead of unit_ (MseOptions::localScale)
-  double unitAt(size_t p) const { return units_.empty() ? unit_ : units_[p]; }
   std::vector<float> planes_;  // plane (g·(entries + 1) + e), e = packed upper triangle, then c
   std::vector<BaseMask> valid_;
   std::vector<char> fallback_;
@@ -207,15 +202,10 @@ class MseEstimator {
                const MseOptions& options, const Image* reference);
   // Per-pixel (unwindowed) planes for rows [y0, y1); returns per pixel the bases whose entries
   // it holds (finite there; 0: the pixel holds nothing, e.g. a non-finite noisy comparator).
-  // Absolute: divided by the scale² at the pixel; Relative: by μ̂² + kRelMseEpsilon; Prior: by
-  // μ̂² + (scale at the pixel / 2)².
-  enum class TermUnits { Absolute, Relative, Prior };
+  // relativeEpsilon < 0: absolute units (divided by scale²); else divided by μ̂² + relativeEpsilon.
   std::vector<BaseMask> pixelTerms(int y0, int y1, std::vector<float>& planes,
-                                   TermUnits units) const;
-  TermUnits objectiveUnits() const;
-  // The mean |x| the terms and allowances at a pixel are relative to (scale_ or localScale_).
-  double scaleAt(size_t pixel) const { return localScale_.empty() ? scale_ : localScale_[pixel]; }
-  void computeLocalScale(const EnsembleGuides& guides);
+                                   double relativeEpsilon) const;
+  double objectiveEpsilon() const;
   BaseMask computeValidAt(size_t pixel) const;  // what validAt returns, from the images
   // The mean of the relative per-pixel terms, each entry over the pixels where both its bases
   // are present (empty when no pixel has any); addImagePrior scales it per pixel.
@@ -268,7 +258,6 @@ class MseEstimator {
   MseOptions options_;
   int width_ = 0, height_ = 0, baseCount_ = 0;
   double scale_ = 1.0;  // absolute form: values are divided by scale² (scale = mean |x|)
-  std::vector<double> localScale_;  // MseOptions::localScale: per pixel
   std::array<const float*, kMaxDenoisers> outFull_{};
   std::vector<Fold> folds_;           // the tests' folds and the estimate's (weight primary)
   std::vector<Fold> secondaryFolds_;  // Extrapolated: the halves (weight secondary)

@@ -30,9 +30,6 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
       ->each([this](const std::string&) { windowGiven = true; });
   cmd.add_flag("--relative,!--absolute", relative,
                "Divide the MSE estimate by (mean² + 0.01) so that it targets relMSE");
-  cmd.add_flag("--local-scale,!--image-scale", localScale,
-               "Measure the MSE terms, the outlier cap and the tests' allowances against the "
-               "mean |x| of each pixel's window instead of the image's");
   cmd.add_option("--outlier-cap", outlierCap,
                  "Scale each pixel's MSE terms by F/(trace + F) before the window (trace in units "
                  "of mean|x|²), so that a firefly counts about as much as F in its neighbours' "
@@ -95,7 +92,6 @@ CombineOptions EnsembleFlags::options() const {
   o.mse.windowRadius = window;
   if (windowGiven) o.mse.fullRunWindowRadius = window;  // one radius everywhere
   o.mse.relative = relative;
-  o.mse.localScale = localScale;
   o.mse.outlierCap = outlierCap;
   o.mse.consistency = consistency;
   o.mse.plausibility = plausibility;

@@ -20,7 +20,6 @@ struct EnsembleFlags {
   double imagePrior = MseOptions{}.imagePrior;
   double noisyFallback = MseOptions{}.noisyFallback;
   double memberFallback = MseOptions{}.memberFallback;
-  bool localScale = MseOptions{}.localScale;
   uint64_t seed = 1;
 
   bool weightFilterGiven = false;    // --weight-filter was on the command line

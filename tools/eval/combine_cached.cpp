@@ -39,8 +39,7 @@ struct Args {
   std::string cache, name, out, methods, combos, combiners = "ensemble";
   std::string previewMethods, previewSpp = "4", spp;
   int threads = 2;
-  bool fullFromHeldOut = false, diagnose = false, noHalfRuns = false, fullFromHalves = false,
-       twoFolds = false;
+  bool fullFromHeldOut = false, diagnose = false, noHalfRuns = false;
   cli::EnsembleFlags ensemble;
 };
 
@@ -61,11 +60,7 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
                                       const std::vector<std::string>& methods,
                                       const std::vector<std::string>& combos,
                                       const CombineOptions& base, const Image& reference) {
-  EnsembleGuides guides = readCachedGuides(caseDir);
-  if (args.twoFolds && guides.quarters.size() == 4) {
-    guides.quarters[1] = guides.quarters[0];
-    guides.quarters[2] = guides.quarters[3];
-  }
+  const EnsembleGuides guides = readCachedGuides(caseDir);
   // Members alone are always their full-buffer runs (what a user running one pays for).
   std::map<std::string, BaseOutputs> outputs;
   std::map<std::string, Image> alone;
@@ -73,10 +68,6 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
     BaseOutputs& o = outputs[m] = readCachedMember(caseDir, m);
     alone[m] = o.full;
     if (args.noHalfRuns && o.heldOut.size() == 4) o.a = o.b = Image();
-    if (args.twoFolds && o.heldOut.size() == 4) {
-      o.heldOut[1] = o.heldOut[0];
-      o.heldOut[2] = o.heldOut[3];
-    }
   }
   // What the blends take, as the pipeline decides it (baseRunsFor, optionsForRuns): a case's
   // members all have their held-out runs or none.
@@ -86,13 +77,6 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
                    !blendsFullRuns(guides.width(), guides.height(), spp));
   if (!blended.full)
     for (auto& [name, o] : outputs) o.full = meanOfHeldOutRuns(o);
-  if (args.fullFromHalves)
-    for (auto& [name, o] : outputs) {
-      o.full = o.a;
-      for (size_t i = 0; i < o.full.values().size(); ++i)
-        o.full.data()[i] = 0.5f * (o.a.data()[i] + o.b.data()[i]);
-      o.heldOut.clear();
-    }
   std::vector<sweep::SweepRow> rows = {
       sweep::measuredRow(args.name, spp, "noisy", "-", 0, guides.color, reference, 0, 0)};
   for (const std::string& m : methods)
@@ -200,9 +184,6 @@ int main(int argc, char** argv) {
                "Replace each member's full-buffer output by the mean of its four held-out runs "
                "where the pipeline blends that mean (blendsFullRuns: not on images of >= 32768 "
                "pixels at <= 16 spp)");
-  app.add_flag("--full-from-halves", args.fullFromHalves,
-               "Blend the mean of each member's half runs (drops the held-out runs)");
-  app.add_flag("--two-folds", args.twoFolds, "Only the runs without quarter 0 and quarter 3");
   app.add_flag("--no-half-runs", args.noHalfRuns,
                "Drop the members' half runs where held-out runs replace them (as the pipeline "
                "does for the quarters estimate)");

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <array>
 
 #include <cmath>
@@ -133,14 +134,30 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
   PixelMse out;
   out.groups = groups;
   for (int g = 0; g < groups; ++g) out.h[size_t(g)] = MseMatrix::Zero(n, n);
-  // outlierCap F scales each pixel's terms by F / (tr H (all groups) / u + F), u the unit the
-  // estimator stores values in: 1 for the relative form, else the mean |x^A|, |x^B| squared.
+  // outlierCap F scales each pixel's terms by F / (tr H (all groups) / u + F): u = 1 for the
+  // relative form, else the larger of the mean |x^A|, |x^B| squared and the 95th percentile of
+  // the image's per-pixel traces (every pixel: the fixture is far below 512 rows).
+  const auto absoluteTrace = [&](int qx, int qy) {
+    double trace = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
+      for (const BaseOutputs& b : f.bases)
+        trace += 0.5 * (std::pow(b.a(qx, qy, c) - xB, 2) + std::pow(b.b(qx, qy, c) - xA, 2));
+    }
+    return trace;
+  };
   double unit = 1.0;
   if (!o.relative) {
     double sum = 0;
     for (const Image* image : {&f.guides.colorA, &f.guides.colorB})
       for (float v : image->values()) sum += std::abs(v);
     unit = std::pow(sum / double(2 * f.truth.size()), 2);
+    std::vector<double> traces;
+    for (int qy = 0; qy < h; ++qy)
+      for (int qx = 0; qx < w; ++qx) traces.push_back(absoluteTrace(qx, qy));
+    std::sort(traces.begin(), traces.end());
+    unit =
+        std::max(unit, traces[std::min(traces.size() - 1, size_t(0.95 * double(traces.size())))]);
   }
   // The relative form's 1 / (μ̂² + ε), μ̂ the mean of the full-buffer outputs; 1 otherwise.
   const auto channelWeight = [&](int qx, int qy, int c) {

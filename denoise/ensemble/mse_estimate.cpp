@@ -18,6 +18,10 @@ namespace {
 // where the halves agree closely the full run may still differ by its smaller noise.
 constexpr double kConsistencyAllowance = 0.1;
 
+// The outlier cap's unit is at least this percentile of the image's per-pixel traces (chosen on
+// the corpus's tuning half among 0.75, 0.9, 0.95 and 0.99: docs/ensemble-quality.md).
+constexpr double kCapPercentile = 0.95;
+
 // Rows per task of the image-wide mean of the per-pixel terms, and the most rows it reads.
 constexpr int kPriorBandRows = 32;
 constexpr int kPriorRows = 256;
@@ -200,7 +204,36 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
                       for (size_t p = range.begin(); p < range.end(); ++p)
                         validity_[p] = computeValidAt(p);
                     });
+  if (options.outlierCap > 0 && !reference_ && !options.relative)
+    capUnit_ = std::max(1.0, typicalTrace());
   if (options.imagePrior > 0 && !reference_) imagePrior_ = imagePriorTerms();
+}
+
+double MseEstimator::typicalTrace() const {
+  // Every stride-th row, as the image prior: a percentile needs no more than kPriorRows rows.
+  const int stride = std::max(1, height_ / kPriorRows);
+  std::vector<double> traces;
+  for (int y = 0; y < height_; y += stride)
+    for (int x = 0; x < width_; ++x) {
+      const size_t p = size_t(y) * size_t(width_) + size_t(x);
+      const BaseMask valid = validAt(p);
+      if (valid == 0 || !comparatorsFinite(p)) continue;
+      double trace = 0;
+      for (int i = 0; i < baseCount_; ++i)
+        if ((valid >> i) & 1u)
+          for (const Fold& fold : folds_)
+            for (int c = 0; c < 3; ++c) {
+              const size_t ec = p * 3 + size_t(c);
+              const double d = double(fold.out[size_t(i)][ec]) - fold.comparator[ec];
+              trace += d * d;
+            }
+      trace /= double(folds_.size()) * scale_ * scale_;
+      if (std::isfinite(trace)) traces.push_back(trace);
+    }
+  if (traces.empty()) return 0.0;
+  const size_t k = std::min(traces.size() - 1, size_t(kCapPercentile * double(traces.size())));
+  std::nth_element(traces.begin(), traces.begin() + std::ptrdiff_t(k), traces.end());
+  return traces[k];
 }
 
 void MseEstimator::addPriorRow(int y, std::vector<float>& planes, std::vector<double>& sum,
@@ -544,7 +577,9 @@ std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float
       double trace = 0;
       for (int g = 0; g < groups(); ++g)
         for (int i = 0; i < n; ++i) trace += acc[size_t(g * (entries + 1) + packed(i, i, n))];
-      const double factor = options_.outlierCap / (trace + options_.outlierCap);
+      // Relative terms (the prior's, --relative) keep their own unit.
+      const double unit = relative ? 1.0 : capUnit_;
+      const double factor = options_.outlierCap / (trace / unit + options_.outlierCap);
       for (int k = 0; k < planeCount(); ++k) acc[size_t(k)] *= factor;
     }
     bool finite = true;

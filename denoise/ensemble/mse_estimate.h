@@ -28,10 +28,13 @@
 //   full-buffer outputs (the oracle: the reference), ε = 0.01, so that the objective targets
 //   relMSE instead of MSE.
 // - outlierCap F: before the window, scale each pixel's terms by F / (t + F), t their trace
-//   (Σ_i H_ii over the groups) in units of (mean |x|)² (relative form: relative units). A
-//   typical pixel keeps about its weight; a firefly's terms, whose noise (the cross terms
-//   −x^A y_i^B with a huge x^A) would otherwise choose the weights of every pixel within the
-//   radius, count about as much as F. 0 = off. Measured: README, "Ensemble", Outlier cap.
+//   (Σ_i H_ii over the groups) in units of the larger of (mean |x|)² and the 95th percentile
+//   of the image's traces (relative form: relative units). A typical pixel keeps about its
+//   weight; a firefly's terms, whose noise (the cross terms −x^A y_i^B with a huge x^A) would
+//   otherwise choose the weights of every pixel within the radius, count about as much as F.
+//   The percentile: at a few samples per pixel the comparators' noise alone puts the bright
+//   tenth of an image far above (mean |x|)², and capping it there made the window's sums count
+//   every bright pixel alike instead of by its error (docs/ensemble-quality.md). 0 = off.
 // - consistency k: at a pixel, a base whose full-buffer output lies further than
 //   k·|y^A − y^B|/2 + 0.1·(mean |x| + |ȳ|) from the mean ȳ of its half-buffer outputs in some
 //   channel gets weight 0 (unless every base does). The estimate judges the half-buffer runs;
@@ -258,6 +261,9 @@ class MseEstimator {
   MseOptions options_;
   int width_ = 0, height_ = 0, baseCount_ = 0;
   double scale_ = 1.0;  // absolute form: values are divided by scale² (scale = mean |x|)
+  // The outlier cap's unit over scale²: 1, or the traces' percentile over scale² where larger.
+  double capUnit_ = 1.0;
+  double typicalTrace() const;  // the traces' percentile over scale² (sampled rows)
   std::array<const float*, kMaxDenoisers> outFull_{};
   std::vector<Fold> folds_;           // the tests' folds and the estimate's (weight primary)
   std::vector<Fold> secondaryFolds_;  // Extrapolated: the halves (weight secondary)

@@ -32,8 +32,8 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
                "Divide the MSE estimate by (mean² + 0.01) so that it targets relMSE");
   cmd.add_option("--outlier-cap", outlierCap,
                  "Scale each pixel's MSE terms by F/(trace + F) before the window (trace in units "
-                 "of mean|x|²), so that a firefly counts about as much as F in its neighbours' "
-                 "windows (0 = off)")
+                 "of mean|x|², or of the image's 95th-percentile trace where larger), so that a "
+                 "firefly counts about as much as F in its neighbours' windows (0 = off)")
       ->capture_default_str()
       ->transform(finiteIn(0, kMaxEnsembleFactor));
   cmd.add_option("--consistency", consistency,

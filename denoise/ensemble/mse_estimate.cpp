@@ -212,10 +212,12 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
 double MseEstimator::typicalTrace() const {
   // Every stride-th row, as the image prior: a percentile needs no more than kPriorRows rows.
   const int stride = std::max(1, height_ / kPriorRows);
-  std::vector<double> traces;
-  for (int y = 0; y < height_; y += stride)
+  const int rows = (height_ + stride - 1) / stride;
+  std::vector<std::vector<double>> perRow(static_cast<size_t>(rows));
+  tbb::parallel_for(0, rows, [&](int row) {
+    const size_t y = size_t(row) * size_t(stride);
     for (int x = 0; x < width_; ++x) {
-      const size_t p = size_t(y) * size_t(width_) + size_t(x);
+      const size_t p = y * size_t(width_) + size_t(x);
       const BaseMask valid = validAt(p);
       if (valid == 0 || !comparatorsFinite(p)) continue;
       double trace = 0;
@@ -228,8 +230,11 @@ double MseEstimator::typicalTrace() const {
               trace += d * d;
             }
       trace /= double(folds_.size()) * scale_ * scale_;
-      if (std::isfinite(trace)) traces.push_back(trace);
+      if (std::isfinite(trace)) perRow[size_t(row)].push_back(trace);
     }
+  });
+  std::vector<double> traces;
+  for (const std::vector<double>& row : perRow) traces.insert(traces.end(), row.begin(), row.end());
   if (traces.empty()) return 0.0;
   const size_t k = std::min(traces.size() - 1, size_t(kCapPercentile * double(traces.size())));
   std::nth_element(traces.begin(), traces.begin() + std::ptrdiff_t(k), traces.end());

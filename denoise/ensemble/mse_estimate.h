@@ -33,7 +33,7 @@
 //   weight; a firefly's terms, whose noise (the cross terms −x^A y_i^B with a huge x^A) would
 //   otherwise choose the weights of every pixel within the radius, count about as much as F.
 //   The percentile: at a few samples per pixel the comparators' noise alone puts the bright
-//   tenth of an image far above (mean |x|)², and capping it there made the window's sums count
+//   tail of an image far above (mean |x|)², and capping it there made the window's sums count
 //   every bright pixel alike instead of by its error (docs/ensemble-quality.md). 0 = off.
 // - consistency k: at a pixel, a base whose full-buffer output lies further than
 //   k·|y^A − y^B|/2 + 0.1·(mean |x| + |ȳ|) from the mean ȳ of its half-buffer outputs in some
@@ -213,6 +213,9 @@ class MseEstimator {
   // The mean of the relative per-pixel terms, each entry over the pixels where both its bases
   // are present (empty when no pixel has any); addImagePrior scales it per pixel.
   std::vector<double> imagePriorTerms() const;
+  // The kCapPercentile-th percentile of the per-pixel traces of the absolute terms over scale²
+  // (every stride-th row, as the prior; 0 when no pixel has terms): the outlier cap's unit.
+  double typicalTrace() const;
   // Adds row y's relative per-pixel terms to the prior's sums and their pixel counts.
   void addPriorRow(int y, std::vector<float>& planes, std::vector<double>& sum,
                    std::vector<size_t>& count) const;
@@ -263,7 +266,6 @@ class MseEstimator {
   double scale_ = 1.0;  // absolute form: values are divided by scale² (scale = mean |x|)
   // The outlier cap's unit over scale²: 1, or the traces' percentile over scale² where larger.
   double capUnit_ = 1.0;
-  double typicalTrace() const;  // the traces' percentile over scale² (sampled rows)
   std::array<const float*, kMaxDenoisers> outFull_{};
   std::vector<Fold> folds_;           // the tests' folds and the estimate's (weight primary)
   std::vector<Fold> secondaryFolds_;  // Extrapolated: the halves (weight secondary)

@@ -134,31 +134,6 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
   PixelMse out;
   out.groups = groups;
   for (int g = 0; g < groups; ++g) out.h[size_t(g)] = MseMatrix::Zero(n, n);
-  // outlierCap F scales each pixel's terms by F / (tr H (all groups) / u + F): u = 1 for the
-  // relative form, else the larger of the mean |x^A|, |x^B| squared and the 95th percentile of
-  // the image's per-pixel traces (every pixel: the fixture is far below 512 rows).
-  const auto absoluteTrace = [&](int qx, int qy) {
-    double trace = 0;
-    for (int c = 0; c < 3; ++c) {
-      const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
-      for (const BaseOutputs& b : f.bases)
-        trace += 0.5 * (std::pow(b.a(qx, qy, c) - xB, 2) + std::pow(b.b(qx, qy, c) - xA, 2));
-    }
-    return trace;
-  };
-  double unit = 1.0;
-  if (!o.relative) {
-    double sum = 0;
-    for (const Image* image : {&f.guides.colorA, &f.guides.colorB})
-      for (float v : image->values()) sum += std::abs(v);
-    unit = std::pow(sum / double(2 * f.truth.size()), 2);
-    std::vector<double> traces;
-    for (int qy = 0; qy < h; ++qy)
-      for (int qx = 0; qx < w; ++qx) traces.push_back(absoluteTrace(qx, qy));
-    std::sort(traces.begin(), traces.end());
-    unit =
-        std::max(unit, traces[std::min(traces.size() - 1, size_t(0.95 * double(traces.size())))]);
-  }
   // The relative form's 1 / (μ̂² + ε), μ̂ the mean of the full-buffer outputs; 1 otherwise.
   const auto channelWeight = [&](int qx, int qy, int c) {
     if (!o.relative) return 1.0;
@@ -167,21 +142,40 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
     mu /= n;
     return 1.0 / (mu * mu + kRelMseEpsilon);
   };
+  // Σ_c Σ_i ½((y_i^A − x^B)² + (y_i^B − x^A)²), each channel weighted as the terms are.
+  const auto traceAt = [&](int qx, int qy) {
+    double trace = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
+      for (const BaseOutputs& b : f.bases)
+        trace += channelWeight(qx, qy, c) * 0.5 *
+                 (std::pow(b.a(qx, qy, c) - xB, 2) + std::pow(b.b(qx, qy, c) - xA, 2));
+    }
+    return trace;
+  };
+  // outlierCap F scales each pixel's terms by F / (tr H (all groups) / u + F): u = 1 for the
+  // relative form, else the larger of the mean |x^A|, |x^B| squared and the 95th percentile of
+  // the image's per-pixel traces (every pixel: the fixture is far below 512 rows).
+  double unit = 1.0;
+  if (!o.relative) {
+    double sum = 0;
+    for (const Image* image : {&f.guides.colorA, &f.guides.colorB})
+      for (float v : image->values()) sum += std::abs(v);
+    unit = std::pow(sum / double(2 * f.truth.size()), 2);
+    std::vector<double> traces;
+    for (int qy = 0; qy < h; ++qy)
+      for (int qx = 0; qx < w; ++qx) traces.push_back(traceAt(qx, qy));
+    std::sort(traces.begin(), traces.end());
+    unit =
+        std::max(unit, traces[std::min(traces.size() - 1, size_t(0.95 * double(traces.size())))]);
+  }
   // One pixel's terms (every group), capped, before the window.
   const auto terms = [&](int qx, int qy) {
     std::array<MseMatrix, 3> t;
     for (int g = 0; g < groups; ++g) t[size_t(g)] = MseMatrix::Zero(n, n);
     double cap = 1.0;
     if (o.outlierCap > 0) {
-      double trace = 0;  // Σ_c Σ_i ½((y_i^A − x^B)² + (y_i^B − x^A)²), weighted as below
-      for (int c = 0; c < 3; ++c) {
-        const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
-        const double weight = channelWeight(qx, qy, c);
-        for (const BaseOutputs& b : f.bases)
-          trace +=
-              weight * 0.5 * (std::pow(b.a(qx, qy, c) - xB, 2) + std::pow(b.b(qx, qy, c) - xA, 2));
-      }
-      cap = o.outlierCap / (trace / unit + o.outlierCap);
+      cap = o.outlierCap / (traceAt(qx, qy) / unit + o.outlierCap);
     }
     for (int c = 0; c < 3; ++c) {
       const int g = groups == 3 ? c : 0;

@@ -209,9 +209,14 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
   if (options.imagePrior > 0 && !reference_) imagePrior_ = imagePriorTerms();
 }
 
+int MseEstimator::sampleStride() const {
+  // Every stride-th row: an image-wide statistic needs no more than kPriorRows rows of pixels
+  // (images up to 2 × kPriorRows rows use all of theirs).
+  return std::max(1, height_ / kPriorRows);
+}
+
 double MseEstimator::typicalTrace() const {
-  // Every stride-th row, as the image prior: a percentile needs no more than kPriorRows rows.
-  const int stride = std::max(1, height_ / kPriorRows);
+  const int stride = sampleStride();
   const int rows = (height_ + stride - 1) / stride;
   std::vector<std::vector<double>> perRow(static_cast<size_t>(rows));
   tbb::parallel_for(0, rows, [&](int row) {
@@ -220,16 +225,12 @@ double MseEstimator::typicalTrace() const {
       const size_t p = y * size_t(width_) + size_t(x);
       const BaseMask valid = validAt(p);
       if (valid == 0 || !comparatorsFinite(p)) continue;
+      // Σ_i H_ii before the cap: every base's own error term d_i.
+      const FoldTerms terms = foldTermsAt(p, valid);
       double trace = 0;
       for (int i = 0; i < baseCount_; ++i)
-        if ((valid >> i) & 1u)
-          for (const Fold& fold : folds_)
-            for (int c = 0; c < 3; ++c) {
-              const size_t ec = p * 3 + size_t(c);
-              const double d = double(fold.out[size_t(i)][ec]) - fold.comparator[ec];
-              trace += d * d;
-            }
-      trace /= double(folds_.size()) * scale_ * scale_;
+        if ((valid >> i) & 1u) trace += terms.mean(i);
+      trace /= scale_ * scale_;
       if (std::isfinite(trace)) perRow[size_t(row)].push_back(trace);
     }
   });
@@ -265,10 +266,9 @@ std::vector<double> MseEstimator::imagePriorTerms() const {
   // Bands in parallel, summed in band order (the same result for any thread count). Each entry
   // is the mean over the pixels where its bases are both present (a base missing over a region
   // changes nothing in the other bases' entries).
-  // Every stride-th row: an image-wide mean needs no more than kPriorRows rows of pixels
-  // (images up to 2 × kPriorRows rows use all of theirs), and this pass over the whole image
-  // was half the cost of the per-pixel terms.
-  const int stride = std::max(1, height_ / kPriorRows);
+  // Every stride-th row (sampleStride): this pass over the whole image was half the cost of the
+  // per-pixel terms.
+  const int stride = sampleStride();
   const int rows = (height_ + stride - 1) / stride;
   const int bands = (rows + kPriorBandRows - 1) / kPriorBandRows;
   const int entries = this->entries();

@@ -213,8 +213,10 @@ class MseEstimator {
   // The mean of the relative per-pixel terms, each entry over the pixels where both its bases
   // are present (empty when no pixel has any); addImagePrior scales it per pixel.
   std::vector<double> imagePriorTerms() const;
+  // The row spacing of the image-wide statistics (the prior, typicalTrace).
+  int sampleStride() const;
   // The kCapPercentile-th percentile of the per-pixel traces of the absolute terms over scale²
-  // (every stride-th row, as the prior; 0 when no pixel has terms): the outlier cap's unit.
+  // (every sampleStride-th row; 0 when no pixel has terms): the outlier cap's unit.
   double typicalTrace() const;
   // Adds row y's relative per-pixel terms to the prior's sums and their pixel counts.
   void addPriorRow(int y, std::vector<float>& planes, std::vector<double>& sum,

@@ -234,9 +234,12 @@ TEST(EnsembleCombiners, NeverDarkerThanEveryMemberWhereTheNoisyHalvesMissedTheLi
 // The member fallback (the previews' safeguard, K = 2): beside a light, one member spreads it onto
 // a dark, well-measured column (6 where both noisy halves say 0.05), another less (1); everywhere
 // else the spreading member is exact and the other 10 % off, so every window favours the
-// spreading one. With the tests that veto a member off (plausibility, consistency), the blend
-// takes it on that column; the fallback takes the closer member there (one-hot, never the
-// noisy value) and changes nothing where the blend is plausible.
+// spreading one. With the tests that veto a member off (plausibility, consistency) and windows
+// on features alone, the blend takes it on that column; the fallback takes the closer member
+// there (one-hot, never the noisy value) and changes nothing where the blend is plausible. The
+// window's colour term sees the column as an edge of the members' mean blend (features are flat
+// there) and keeps the neighbours' terms out of its windows: the blend alone is then close to
+// the closer member.
 TEST(EnsembleCombiners, MemberFallbackTakesTheCloserMemberWhereTheBlendIsFarOff) {
   const int w = 32, h = 16, column = 23;
   EnsembleGuides guides;
@@ -259,9 +262,11 @@ TEST(EnsembleCombiners, MemberFallbackTakesTheCloserMemberWhereTheBlendIsFarOff)
   };
   const std::vector<BaseOutputs> bases = {member("closer", 1.1f, 1.0f),
                                           member("spreading", 1.0f, 6.0f)};
-  CombineOptions off;
-  off.mse.plausibility = 0;
-  off.mse.consistency = 0;
+  CombineOptions colorEdges;
+  colorEdges.mse.plausibility = 0;
+  colorEdges.mse.consistency = 0;
+  CombineOptions off = colorEdges;
+  off.mse.windowSigmaColor = 0;
   CombineOptions on = off;
   on.mse.memberFallback = 2;
   const CombineResult without = combine(guides, pointersTo(bases), off);
@@ -273,6 +278,9 @@ TEST(EnsembleCombiners, MemberFallbackTakesTheCloserMemberWhereTheBlendIsFarOff)
       EXPECT_GT(without.image(column, y, c), 3.0f) << y;  // mostly the spreading member
       EXPECT_EQ(with.image(column, y, c), 1.0f) << y;     // the closer member, not the noisy 0.05
     }
+  const CombineResult edges = combine(guides, pointersTo(bases), colorEdges);
+  for (int y = 0; y < h; ++y)
+    for (int c = 0; c < 3; ++c) EXPECT_LT(edges.image(column, y, c), 1.5f) << y;
   // Away from the column (beyond the window's reach of it) nothing changes.
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < column - 12; ++x)

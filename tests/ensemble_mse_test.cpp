@@ -113,8 +113,45 @@ std::vector<const BaseOutputs*> pointers(const Fixture& f) {
   return pointersTo(f.bases);
 }
 
+// The window's colour guide from its definition (MseOptions::windowSigmaColor): the mean z̄ of
+// the bases' full runs and the noisy halves' ½(x^A − x^B)² under a Gaussian blur (radius 4,
+// σ 1.7, clipped and renormalised at the borders), both in units of s = mean |z̄|, plus
+// (0.05 z̄ / s)².
+struct WindowColor {
+  Image z, v;
+};
+WindowColor windowColorOf(const Fixture& f) {
+  const int w = f.truth.width(), h = f.truth.height();
+  WindowColor out{Image(w, h, 3), Image(w, h, 3)};
+  double scale = 0;
+  for (size_t e = 0; e < out.z.size(); ++e) {
+    double sum = 0;
+    for (const BaseOutputs& b : f.bases) sum += b.full.data()[e];
+    out.z.data()[e] = float(sum / double(f.bases.size()));
+    scale += std::abs(out.z.data()[e]) / double(out.z.size());
+  }
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0, weight = 0;
+        for (int qy = std::max(0, y - 4); qy <= std::min(h - 1, y + 4); ++qy)
+          for (int qx = std::max(0, x - 4); qx <= std::min(w - 1, x + 4); ++qx) {
+            const double t =
+                std::exp(-0.5 * ((qx - x) * (qx - x) + (qy - y) * (qy - y)) / (1.7 * 1.7));
+            const double d = double(f.guides.colorA(qx, qy, c)) - f.guides.colorB(qx, qy, c);
+            sum += t * 0.5 * d * d;
+            weight += t;
+          }
+        const double z = out.z(x, y, c) / scale;
+        out.v(x, y, c) = float(sum / weight / (scale * scale) + std::pow(0.05 * z, 2));
+        out.z(x, y, c) = float(z);
+      }
+  return out;
+}
+
 // The window's joint-bilateral weight k(p, q), in double.
-double windowWeight(const Fixture& f, const MseOptions& o, int x, int y, int qx, int qy) {
+double windowWeight(const Fixture& f, const MseOptions& o, const WindowColor& color, int x, int y,
+                    int qx, int qy) {
   if (o.windowRadius == 0) return 1.0;
   const double sigmaSpatial = o.windowSigmaSpatial > 0 ? o.windowSigmaSpatial : o.windowRadius;
   double d = ((qx - x) * (qx - x) + (qy - y) * (qy - y)) / (2 * sigmaSpatial * sigmaSpatial);
@@ -123,6 +160,10 @@ double windowWeight(const Fixture& f, const MseOptions& o, int x, int y, int qx,
          (2.0 * o.windowSigmaNormal * o.windowSigmaNormal);
     d += std::pow(f.guides.albedo(x, y, c) - f.guides.albedo(qx, qy, c), 2) /
          (2.0 * o.windowSigmaAlbedo * o.windowSigmaAlbedo);
+    if (o.windowSigmaColor > 0)
+      d += std::pow(color.z(x, y, c) - color.z(qx, qy, c), 2) /
+           (2.0 * o.windowSigmaColor * o.windowSigmaColor *
+            (double(color.v(x, y, c)) + color.v(qx, qy, c) + 1e-6));
   }
   return std::exp(-d);
 }
@@ -131,6 +172,7 @@ double windowWeight(const Fixture& f, const MseOptions& o, int x, int y, int qx,
 PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
   const int n = int(f.bases.size()), w = f.truth.width(), h = f.truth.height();
   const int groups = o.form == MseForm::PerChannel ? 3 : 1;
+  const WindowColor color = windowColorOf(f);
   PixelMse out;
   out.groups = groups;
   for (int g = 0; g < groups; ++g) out.h[size_t(g)] = MseMatrix::Zero(n, n);
@@ -201,7 +243,7 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
     for (int qx = std::max(0, x - o.windowRadius); qx <= std::min(w - 1, x + o.windowRadius);
          ++qx) {
       if ((qx - x) % step != 0 || (qy - y) % step != 0) continue;
-      const double k = windowWeight(f, o, x, y, qx, qy);
+      const double k = windowWeight(f, o, color, x, y, qx, qy);
       kernelSum += k;
       const int b = step / 2;
       int boxPixels = 0;
@@ -268,6 +310,7 @@ TEST(MseEstimate, MatchesTheDefinition) {
 std::vector<double> meanDeviation(const Fixture& f, const MseOptions& o) {
   const MseEstimator estimator(f.guides, pointers(f), o);
   const int n = 3, w = f.truth.width(), h = f.truth.height(), r = o.windowRadius;
+  const WindowColor color = windowColorOf(f);
   std::vector<std::vector<const Image*>> runs(static_cast<size_t>(n));  // per base, runs judged
   for (int i = 0; i < n; ++i) {
     const BaseOutputs& b = f.bases[size_t(i)];
@@ -295,7 +338,7 @@ std::vector<double> meanDeviation(const Fixture& f, const MseOptions& o) {
             double truth = 0, kernelSum = 0;
             for (int qy = std::max(0, y - r); qy <= std::min(h - 1, y + r); ++qy)
               for (int qx = std::max(0, x - r); qx <= std::min(w - 1, x + r); ++qx) {
-                const double k = windowWeight(f, o, x, y, qx, qy);
+                const double k = windowWeight(f, o, color, x, y, qx, qy);
                 truth += k * trueEntry(qx, qy, c, i, j);
                 kernelSum += k;
               }

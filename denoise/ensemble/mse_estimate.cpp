@@ -9,6 +9,7 @@
 
 #include "common/error.h"
 #include "denoise/base/filters/box_filter.h"
+#include "denoise/ensemble/weight_filter.h"
 #include "denoise/metrics/metrics.h"
 
 namespace chorus {
@@ -21,6 +22,11 @@ constexpr double kConsistencyAllowance = 0.1;
 // The outlier cap's unit is at least this percentile of the image's per-pixel traces (chosen on
 // the corpus's tuning half among 0.75, 0.9, 0.95 and 0.99: docs/ensemble-quality.md).
 constexpr double kCapPercentile = 0.95;
+
+// The window's colour term: guide differences within this fraction of the guide itself count as
+// no edge (chosen on the corpus's tuning half among 0, 0.02, 0.05 and 0.1:
+// docs/ensemble-quality.md).
+constexpr double kWindowColorTolerance = 0.05;
 
 // Rows per task of the image-wide mean of the per-pixel terms, and the most rows it reads.
 constexpr int kPriorBandRows = 32;
@@ -72,6 +78,25 @@ std::vector<float> finitePlanes(const Image& image) {
       planes[size_t(c) * pixels + p] = std::isfinite(v) ? v : 0.0f;
     }
   return planes;
+}
+
+// Per value, the mean of the bases' full runs that are finite there (0 where none is).
+Image meanOfFiniteRuns(std::span<const BaseOutputs* const> bases) {
+  const Image& first = bases[0]->full;
+  Image mean(first.width(), first.height(), first.channels());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, mean.size()),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      for (size_t e = range.begin(); e < range.end(); ++e) {
+                        double sum = 0;
+                        int count = 0;
+                        for (const BaseOutputs* base : bases) {
+                          const float v = base->full.data()[e];
+                          if (std::isfinite(v)) sum += v, ++count;
+                        }
+                        mean.data()[e] = count > 0 ? float(sum / count) : 0.0f;
+                      }
+                    });
+  return mean;
 }
 
 }  // namespace
@@ -195,6 +220,23 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
     windowGuides_.height = height_;
     windowGuides_.normal = finitePlanes(guides.normal);
     windowGuides_.albedo = finitePlanes(guides.albedo);
+    if (options.windowSigmaColor > 0 && !reference) {
+      // The members' mean blend: smooth, so it shows shadow edges and caustics that the features
+      // do not, without the noisy colour's correlation with the comparators; its differences in
+      // units of the noisy halves' spread (the weight filter's guide, makeColorGuide), so that
+      // only a step larger than a half's noise separates two pixels.
+      ColorGuide color = makeColorGuide(meanOfFiniteRuns(bases), guides.colorA, guides.colorB, {});
+      // A relative tolerance beside the noise: smooth shading is not an edge however clean the
+      // render (without it the windows shrink to single pixels as the noise vanishes).
+      for (size_t e = 0; e < color.variance.size(); ++e) {
+        const double z = color.color.data()[e], tolerance = kWindowColorTolerance * z;
+        color.variance.data()[e] =
+            float(std::min(1e12, double(color.variance.data()[e]) + tolerance * tolerance));
+      }
+      windowGuides_.color = finitePlanes(color.color);
+      windowGuides_.variance = finitePlanes(color.variance);
+      windowKernel_.kColor = 0.5f / (options.windowSigmaColor * options.windowSigmaColor);
+    }
   }
   // Every pass over the image asks which bases are finite at a pixel (the masks, the terms with
   // their window's halo, the prior): once per pixel here instead of four times there.

@@ -20,7 +20,11 @@
 //   or the sum over the three channels (one weight vector per pixel).
 // - windowRadius: accumulate H and c over a (2r+1)² neighbourhood with joint-bilateral weights
 //   k(p,q) = exp(−|p−q|²/(2σ_s²) − |n_p−n_q|²/(2σ_n²) − |a_p−a_q|²/(2σ_a²)) from the normal
-//   and albedo (not the noisy colour, which would correlate the weights with the residuals).
+//   and albedo (not the noisy colour, which would correlate the weights with the residuals),
+//   and, with windowSigmaColor σ_z > 0, a colour term exp(−Σ_c (z̄_c(p) − z̄_c(q))² /
+//   (2σ_z² (V_c(p) + V_c(q)))) on the mean z̄ of the bases' full runs, V the noisy halves'
+//   blurred ½(x^A − x^B)²: a window stops at a shadow edge or a caustic that the features do
+//   not show. z̄ barely follows one comparator's noise (the members smooth it away).
 //   0 = per pixel, as in the paper. Accumulating keeps the estimate unbiased (up to the
 //   normalisation by Σk, which does not change the minimiser) and averages out the noise of
 //   x^A, x^B, which otherwise dominates the per-pixel choice (README: evidence).
@@ -128,6 +132,9 @@ struct MseOptions {
   float windowSigmaSpatial = 0;  // σ_s in pixels; 0 = the window radius
   float windowSigmaNormal = 0.2f;
   float windowSigmaAlbedo = 0.1f;
+  // σ of the window's colour term on the members' mean blend, in units of the noisy halves'
+  // spread; 0 = features only (the oracle always uses features only).
+  float windowSigmaColor = 2.0f;
 };
 
 // ⟨M⟩ at one pixel in the objective's units (radiance², or relative), per channel group g

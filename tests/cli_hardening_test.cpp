@@ -91,6 +91,7 @@ const std::vector<BadFlag> kBadRenderFlags = {
     {"--camera", "1e9"},
     {"--window", "1000000"},
     {"--window", "-1"},
+    {"--window-color", "nan"},
     {"--outlier-cap", "nan"},
     {"--outlier-cap", "-1"},
     {"--consistency", "inf"},

@@ -28,6 +28,12 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
                  "full runs of members that split their input: large renders at <= 16 spp)")
       ->transform(integerIn(0, kMaxWindowRadius))
       ->each([this](const std::string&) { windowGiven = true; });
+  cmd.add_option("--window-color", windowColor,
+                 "Colour term of that window: pixels whose mean of the members differs by more "
+                 "than about S times the noisy halves' spread (or 5 %) are outside it, so that it "
+                 "stops at shadow edges and caustics (0 = normals and albedo only)")
+      ->capture_default_str()
+      ->transform(finiteIn(0, kMaxEnsembleFactor));
   cmd.add_flag("--relative,!--absolute", relative,
                "Divide the MSE estimate by (mean² + 0.01) so that it targets relMSE");
   cmd.add_option("--outlier-cap", outlierCap,
@@ -91,6 +97,7 @@ CombineOptions EnsembleFlags::options() const {
   // The numbers were range-checked when the flags were parsed (addFlags).
   o.mse.windowRadius = window;
   if (windowGiven) o.mse.fullRunWindowRadius = window;  // one radius everywhere
+  o.mse.windowSigmaColor = float(windowColor);
   o.mse.relative = relative;
   o.mse.outlierCap = outlierCap;
   o.mse.consistency = consistency;

@@ -13,6 +13,7 @@ struct EnsembleFlags {
   std::string solver = "active-set", weightFilter = "bilateral", mseForm = "summed";
   std::string estimate = estimateName(MseOptions{}.estimate);
   int window = MseOptions{}.windowRadius;
+  double windowColor = MseOptions{}.windowSigmaColor;
   bool relative = MseOptions{}.relative;
   double outlierCap = MseOptions{}.outlierCap;
   double consistency = MseOptions{}.consistency;

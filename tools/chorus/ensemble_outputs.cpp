@@ -54,6 +54,7 @@ nlohmann::ordered_json combineOptionsJson(const CombineOptions& o) {
           {"estimate", estimateName(o.mse.estimate)},
           {"window", o.mse.windowRadius},
           {"full_run_window", o.mse.fullRunWindowRadius},
+          {"window_color", o.mse.windowSigmaColor},
           {"relative", o.mse.relative},
           {"outlier_cap", o.mse.outlierCap},
           {"consistency", o.mse.consistency},

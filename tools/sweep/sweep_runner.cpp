@@ -94,12 +94,12 @@ std::string sweepSettings(const SweepConfig& config) {
     text << " spp " << config.referenceSpp << " seconds " << config.referenceSeconds;
   text << "\nensemble " << solverName(c.solver) << " "
        << (c.mse.form == MseForm::Summed ? "summed" : "per-channel") << " window "
-       << c.mse.windowRadius << " full-run-window " << c.mse.fullRunWindowRadius
-       << (c.mse.relative ? " relative" : " absolute") << " outlier-cap " << c.mse.outlierCap
-       << " consistency " << c.mse.consistency << " plausibility " << c.mse.plausibility
-       << " image-prior " << c.mse.imagePrior << " noisy-fallback " << c.mse.noisyFallback
-       << " filter " << (c.filter.enabled ? "bilateral" : "none") << " seed " << c.seed << "\ncrop "
-       << config.cropSize << "\n";
+       << c.mse.windowRadius << " full-run-window " << c.mse.fullRunWindowRadius << " window-color "
+       << c.mse.windowSigmaColor << (c.mse.relative ? " relative" : " absolute") << " outlier-cap "
+       << c.mse.outlierCap << " consistency " << c.mse.consistency << " plausibility "
+       << c.mse.plausibility << " image-prior " << c.mse.imagePrior << " noisy-fallback "
+       << c.mse.noisyFallback << " filter " << (c.filter.enabled ? "bilateral" : "none") << " seed "
+       << c.seed << "\ncrop " << config.cropSize << "\n";
   return text.str();
 }
 

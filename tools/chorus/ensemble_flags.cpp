@@ -31,9 +31,11 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
   cmd.add_option("--window-color", windowColor,
                  "Colour term of that window: pixels whose mean of the members differs by more "
                  "than about S times the noisy halves' spread (or 5 %) are outside it, so that it "
-                 "stops at shadow edges and caustics (0 = normals and albedo only)")
+                 "stops at shadow edges and caustics (0 = normals and albedo only; previews: 0 "
+                 "unless given)")
       ->capture_default_str()
-      ->transform(finiteIn(0, kMaxEnsembleFactor));
+      ->transform(finiteIn(0, kMaxEnsembleFactor))
+      ->each([this](const std::string&) { windowColorGiven = true; });
   cmd.add_flag("--relative,!--absolute", relative,
                "Divide the MSE estimate by (mean² + 0.01) so that it targets relMSE");
   cmd.add_option("--outlier-cap", outlierCap,

@@ -27,6 +27,7 @@ struct EnsembleFlags {
   bool imagePriorGiven = false;      // --image-prior was on the command line
   bool memberFallbackGiven = false;  // --member-fallback was on the command line
   bool windowGiven = false;          // --window was on the command line (no full-run radius)
+  bool windowColorGiven = false;     // --window-color was on the command line
 
   void addFlags(CLI::App& cmd);
   // Throws chorus::Error for an unknown value.

@@ -32,12 +32,16 @@ inline constexpr const char* kPreviewDenoise =
 // 0.00505 without, 0.00511 with, and a pass over the image less), and the member fallback at
 // K = 2 (where the blend's own error is 4× the best member's, that member: a permissive à-trous
 // spreading a light onto a dark, well-measured pixel held 79 % of a 512² preview's error;
-// docs/ensemble-quality.md). For `chorus render --preview` and bench_preview alike.
+// docs/ensemble-quality.md), and a window on features only (the colour term lost on every
+// tuning half of the previews: 128–160 px renders 0.969 → 0.972 of the better member, 256 and
+// 512 px 0.832 → 0.832 and 0.750 → 0.751; docs/ensemble-quality.md). For `chorus render
+// --preview` and bench_preview alike.
 inline constexpr double kPreviewMemberFallback = 2.0;
 inline void applyPreviewDefaults(CombineOptions& options, const EnsembleFlags& given = {}) {
   if (!given.weightFilterGiven) options.filter.enabled = false;
   if (!given.imagePriorGiven) options.mse.imagePrior = 0;
   if (!given.memberFallbackGiven) options.mse.memberFallback = kPreviewMemberFallback;
+  if (!given.windowColorGiven) options.mse.windowSigmaColor = 0;
 }
 
 struct DenoiseStage {

@@ -224,15 +224,13 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
       // The members' mean blend: smooth, so it shows shadow edges and caustics that the features
       // do not, without the noisy colour's correlation with the comparators; its differences in
       // units of the noisy halves' spread (the weight filter's guide, makeColorGuide), so that
-      // only a step larger than a half's noise separates two pixels.
-      ColorGuide color = makeColorGuide(meanOfFiniteRuns(bases), guides.colorA, guides.colorB, {});
-      // A relative tolerance beside the noise: smooth shading is not an edge however clean the
-      // render (without it the windows shrink to single pixels as the noise vanishes).
-      for (size_t e = 0; e < color.variance.size(); ++e) {
-        const double z = color.color.data()[e], tolerance = kWindowColorTolerance * z;
-        color.variance.data()[e] =
-            float(std::min(1e12, double(color.variance.data()[e]) + tolerance * tolerance));
-      }
+      // only a step larger than a half's noise separates two pixels. Beside the noise, a
+      // relative tolerance: smooth shading is not an edge however clean the render (without it
+      // the windows shrink to single pixels as the noise vanishes).
+      WeightFilterOptions guideOptions;
+      guideOptions.relativeTolerance = kWindowColorTolerance;
+      const ColorGuide color =
+          makeColorGuide(meanOfFiniteRuns(bases), guides.colorA, guides.colorB, guideOptions);
       windowGuides_.color = finitePlanes(color.color);
       windowGuides_.variance = finitePlanes(color.variance);
       windowKernel_.kColor = 0.5f / (options.windowSigmaColor * options.windowSigmaColor);

@@ -94,6 +94,14 @@ ColorGuide colorGuide(const Image& blend, const HalfVariance& halfVarianceAt,
   });
   guide.variance =
       gaussianBlur(halfVariance, options.varianceBlurRadius, options.varianceBlurSigma);
+  if (options.relativeTolerance > 0)
+    forPixelBlocks(blend.pixelCount(), [&](size_t p0, size_t p1) {
+      for (size_t e = p0 * size_t(channels); e < p1 * size_t(channels); ++e) {
+        const double tolerance = options.relativeTolerance * guide.color.data()[e];
+        guide.variance.data()[e] =
+            float(std::min(1e12, double(guide.variance.data()[e]) + tolerance * tolerance));
+      }
+    });
   return guide;
 }
 

@@ -30,6 +30,9 @@ struct WeightFilterOptions {
   float sigmaAlbedo = 0.5f;    // σ_a
   int varianceBlurRadius = 4;  // Gaussian blur of ½(z^A − z^B)²: 9×9, σ = 1.7 (as OpenCV's
   float varianceBlurSigma = 1.7f;  // GaussianBlur with ksize 9 in the reference code)
+  // Added to the guide's V as (tolerance · z)² after the blur: differences within that fraction
+  // of z never separate two pixels (0 here; the MSE window's colour term uses 0.05).
+  double relativeTolerance = 0.0;
 };
 
 // The colour guide of the filter: z / s and V / s², s = mean |z| over the finite values,

@@ -232,6 +232,13 @@ TEST(GuardedDenoiser, RegistryMembersKeepTheirNamesAndRequirements) {
       EXPECT_NE(std::string(e.what()).find("spread must be"), std::string::npos) << e.what();
     }
   }
+  EXPECT_NO_THROW(createDenoiser("atrous:peak=0"));
+  try {
+    createDenoiser("atrous:peak=-1");
+    ADD_FAILURE() << "peak=-1";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("peak must be"), std::string::npos) << e.what();
+  }
 }
 
 TEST(OutputValues, RepairsAndCounts) {

@@ -150,6 +150,61 @@ TEST(OutlierGuard, AWiderSpreadKeepsTheEnergyInAFainterBlob) {
   EXPECT_GT(wideOut(3, 20, 0), s.color.mean(3, 20, 0));
 }
 
+// A rare path found twice in a dark, well-sampled region (issue 25's glass-caustics at 256 spp):
+// 64 samples per pixel of 0.001 and 0.003 (level 0.002), and at (30, 30) and (31, 30) one of
+// the 64 is 3000 (a mean of ~46.9, peers of each other). At radius 6 their excess made a blob
+// peaking at ~1.7, 800 times the level; spread until the peak is about the neighbourhood's
+// level plus noise, the radius reaches its limit of 32 (σ 16): each blob then peaks at about
+// 46.9 / (2π 16²) ≈ 0.029, the two together below 0.08 with the level. The energy stays.
+TEST(OutlierGuard, ARarePathInTheDarkIsSpreadThin) {
+  const SubBuffer s = fromSamples(64, 64, [](int x, int y) {
+    std::vector<double> v(64);
+    for (size_t i = 0; i < v.size(); ++i) v[i] = i % 2 ? 0.003 : 0.001;
+    if (y == 30 && (x == 30 || x == 31)) v[0] = 3000.0;
+    return v;
+  });
+  OutlierGuardOptions fixed;
+  fixed.spreadPeak = 0;
+  const GuardedInput thin = guardOutliers(wholeOnly(s)), blob = guardOutliers(wholeOnly(s), fixed);
+  ASSERT_EQ(thin.clampedValues, 6u);  // two pixels, three channels
+  const double before = channelSum(s.color.mean);
+  EXPECT_NEAR(channelSum(thin.input.whole.color.mean), before, 1e-5 * before);
+  EXPECT_NEAR(channelSum(blob.input.whole.color.mean), before, 1e-5 * before);
+  float thinPeak = 0, blobPeak = 0;
+  for (float v : thin.input.whole.color.mean.values()) thinPeak = std::max(thinPeak, v);
+  for (float v : blob.input.whole.color.mean.values()) blobPeak = std::max(blobPeak, v);
+  EXPECT_GT(blobPeak, 1.0f);
+  EXPECT_LT(thinPeak, 0.08f);
+  EXPECT_GT(thinPeak, 0.04f);
+  // 20 pixels away: beyond radius 6, well inside 32.
+  EXPECT_EQ(blob.input.whole.color.mean(10, 30, 0), s.color.mean(10, 30, 0));
+  EXPECT_GT(thin.input.whole.color.mean(10, 30, 0), s.color.mean(10, 30, 0) + 0.005f);
+}
+
+// Where the neighbourhood is lit (samples of 1 ± 0.5, a sparse caustic of one sample of 30 in
+// four) a blob of radius 6 peaks well below its level, and where the level is 0 (the only light
+// comes in sparse samples, which the median does not measure) nothing says it stands out: both
+// are spread exactly as with the fixed radius.
+TEST(OutlierGuard, WhereTheNeighbourhoodIsLitOrSparseTheRadiusStays) {
+  for (const double floorValue : {1.0, 0.0}) {
+    const SubBuffer s = fromSamples(40, 40, [floorValue](int x, int y) {
+      std::vector<double> v = floorValue > 0 ? ordinary(x, y, 7) : std::vector<double>(4, 0.0);
+      if (x >= 12 && x < 28 && y >= 12 && y < 28 && (3 * x + 5 * y) % 11 == 0) v[0] = 30.0;
+      return v;
+    });
+    OutlierGuardOptions fixed;
+    fixed.spreadPeak = 0;
+    const GuardedInput g = guardOutliers(wholeOnly(s)), f = guardOutliers(wholeOnly(s), fixed);
+    ASSERT_GT(g.clampedValues, 0u) << floorValue;
+    for (size_t i = 0; i < s.color.mean.size(); ++i)
+      ASSERT_EQ(g.input.whole.color.mean.data()[i], f.input.whole.color.mean.data()[i])
+          << floorValue << " at " << i;
+    // …and the excess was spread (not dropped): the energy stays.
+    const double before = channelSum(s.color.mean);
+    EXPECT_NEAR(channelSum(g.input.whole.color.mean), before, 1e-5 * before) << floorValue;
+  }
+}
+
 // The caustic of FirefliesWithPeersKeepTheirEnergy on a surface that ends at x = 20; beyond it
 // every sample misses a black background.
 SubBuffer causticUpToAnEdge(float backgroundDepth) {

@@ -23,6 +23,7 @@ constexpr double kMadToSigma = 1.4826;
 constexpr float kMaxFloat = std::numeric_limits<float>::max();
 // A few units in the last place of a float, relative.
 constexpr double kFloatResolution = 1e-6;
+constexpr double kPi = 3.14159265358979323846;
 
 // The sample count of pixel i, or 0 ("unknown") when the buffer has none recorded.
 float countAt(const SubBuffer& buffer, size_t i) {
@@ -137,16 +138,30 @@ class PartGuard {
   struct Excess {
     int x, y, c;
     double amount;
+    int radius;  // of the window it is spread over (spreadRadiusFor)
   };
 
-  // Adds amount × g(q) s(q) / Σ g to every pixel q of the (2 spreadRadius + 1)² window inside
+  // spreadRadius, or wider where a blob of that radius would stand far above the outlier's
+  // neighbourhood: the radius at which its peak, about 2 amount / (π r²) (a Gaussian of
+  // σ = r / 2), is spreadPeak × (L + σ_N), up to kMaxGuardSpread. A caustic path found once
+  // among 64 samples of a pixel whose neighbours read 0.004 (an excess of ~50) left a blob of
+  // ~0.8 over the dark pixels around it at radius 6. Where L is 0 the neighbourhood's light
+  // comes in sparse samples whose level the median does not measure: the radius stays.
+  int spreadRadiusFor(double amount, double level, double noise) const {
+    const int r = o_.spreadRadius;
+    if (!(o_.spreadPeak > 0.0f) || !(level > 0.0)) return r;
+    const double wanted = std::sqrt(2.0 * amount / (kPi * o_.spreadPeak * (level + noise)));
+    return wanted > r ? int(std::ceil(std::min(wanted, double(kMaxGuardSpread)))) : r;
+  }
+
+  // Adds amount × g(q) s(q) / Σ g to every pixel q of the (2 e.radius + 1)² window inside
   // the image, the outlier's own included, with the Gaussian g(q) = exp(−|q − p|² / (2 (r/2)²))
   // and s(q) = sameSurface: on one surface the window keeps the outlier's energy, without the
   // edges a box would draw. The share that falls on other surfaces is dropped, not given to the
   // outlier's surface: on a thin one (a lamp's arm, a few pixels wide) that concentrated an
   // excess of the whole window onto a handful of pixels (0.96 where the reference is 0.004).
   void spread(const Excess& e, MeanVariance& out, std::vector<uint8_t>& changed) const {
-    const int w = part_.width(), h = part_.height(), r = o_.spreadRadius;
+    const int w = part_.width(), h = part_.height(), r = e.radius;
     const int x0 = std::max(0, e.x - r), x1 = std::min(w - 1, e.x + r);
     const int y0 = std::max(0, e.y - r), y1 = std::min(h - 1, e.y + r);
     const double falloff = 2.0 / (double(r) * double(r));  // 1 / (2 σ²), σ = r / 2
@@ -285,7 +300,8 @@ class PartGuard {
         double squares = 0;
         for (int i = 0; i < count; ++i) squares += (first[i] - level) * (first[i] - level);
         if (value - level <= o_.peerSigmas * std::sqrt(squares / count))
-          excesses.push_back({x, y, c, value - clampedValue});
+          excesses.push_back(
+              {x, y, c, value - clampedValue, spreadRadiusFor(value - clampedValue, level, noise)});
         const double excess = clampedValue - level;
         const double cap = std::max(noise * noise, excess * excess);
         const float v = variance(x, y, c);

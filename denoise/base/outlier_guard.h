@@ -18,13 +18,14 @@
 // becomes S's mean without its largest sample (see withoutLargestSample; L for a single
 // sample), kept within [min(0, L), T]; its variance of the mean min(v, max(σ_N², (x' − L)²)).
 // What it had above that is dropped when the outlier is alone, but spread over the
-// (2 spreadRadius + 1)² window around it (Gaussian weights, σ = spreadRadius / 2, times a
-// Gaussian in the relative depth difference: the same surface only) when it has
-// peers: x − L ≤ peerSigmas × the RMS
+// (2 R + 1)² window around it (Gaussian weights, σ = R / 2, times a Gaussian in the relative
+// depth difference: the same surface only) when it has peers: x − L ≤ peerSigmas × the RMS
 // deviation of the neighbours from L, i.e. a few neighbours deviate as much. Such outliers are
 // the samples of a heavy-tailed distribution that is really there (caustic paths): dropping
 // them would darken the caustic at any sample count the guard still acts at; spread, they keep
-// its energy in the window and lose only their variance.
+// its energy in the window and lose only their variance. R = spreadRadius, or where L > 0
+// and the blob would peak above spreadPeak × (L + σ_N), the radius at which it does not (at
+// most kMaxGuardSpread): a rare path's excess in a dark neighbourhood is spread thin.
 // Each sub-buffer is judged on its own neighbourhood and the samples of the input it belongs
 // to, so runs on half A still see only half A. When the halves change, the whole is re-merged
 // from them at those pixels (whole = merge(halves) keeps holding).
@@ -42,7 +43,8 @@ struct OutlierGuardOptions {
   float highFactor = 4.0f;
   float confirmSigmas = 2.5f;
   float peerSigmas = 6.0f;
-  int spreadRadius = 6;  // a member spec's spread=R (1 … kMaxGuardSpread)
+  int spreadRadius = 6;     // a member spec's spread=R (1 … kMaxGuardSpread)
+  float spreadPeak = 1.0f;  // wider where the blob would peak above this × (L + σ_N); 0: never
   bool operator==(const OutlierGuardOptions&) const = default;
 };
 

@@ -67,6 +67,9 @@ std::unique_ptr<BaseDenoiser> createDenoiser(const std::string& spec) {
       if (guard.spreadRadius < 1 || guard.spreadRadius > kMaxGuardSpread)
         throw Error("spread must be a radius of 1 … " + std::to_string(kMaxGuardSpread) +
                     " pixels");
+      guard.spreadPeak = params.getFloat("peak", guard.spreadPeak);
+      if (!(guard.spreadPeak >= 0.0f))
+        throw Error("peak must be 0 (the spread radius always) or a positive number");
       denoiser = std::make_unique<GuardedDenoiser>(entry.create(params), guard);
     } catch (const Error& e) {  // a bad value: say which denoiser it was for
       throw Error("denoiser " + name + ": " + e.what());

@@ -9,7 +9,7 @@
 // within 1.1× of its best member (measured on 2026-12-05: 0.98×, 1.04× and 0.90× at 4, 16 and 64
 // spp; before the lens and the sky, 1.3× was allowed at 4 spp; NFOR at 16 spp keeps one firefly
 // beside the bright ball, 69 % of its error), 1.12× at 16 spp: since the guard spreads a rare
-// path's excess thin (2026-12-06) every member and the ensemble are better at every spp, but NL
+// path's excess thin (2026-12-06) every member and the ensemble are better at 4 and 16 spp, NL
 // means most (its held-out mean 0.151 -> 0.134, the ensemble 0.1605 -> 0.1561), and the ensemble
 // of seven is 1.106× its full run. docs/outliers.md has the figures at 128×128 against a
 // 2048-spp reference.

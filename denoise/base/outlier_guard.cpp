@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <numeric>
 #include <stdexcept>
 #include <vector>
@@ -23,7 +24,6 @@ constexpr double kMadToSigma = 1.4826;
 constexpr float kMaxFloat = std::numeric_limits<float>::max();
 // A few units in the last place of a float, relative.
 constexpr double kFloatResolution = 1e-6;
-constexpr double kPi = 3.14159265358979323846;
 
 // The sample count of pixel i, or 0 ("unknown") when the buffer has none recorded.
 float countAt(const SubBuffer& buffer, size_t i) {
@@ -150,7 +150,8 @@ class PartGuard {
   int spreadRadiusFor(double amount, double level, double noise) const {
     const int r = o_.spreadRadius;
     if (!(o_.spreadPeak > 0.0f) || !(level > 0.0)) return r;
-    const double wanted = std::sqrt(2.0 * amount / (kPi * o_.spreadPeak * (level + noise)));
+    const double wanted =
+        std::sqrt(2.0 * amount / (std::numbers::pi * o_.spreadPeak * (level + noise)));
     return wanted > r ? int(std::ceil(std::min(wanted, double(kMaxGuardSpread)))) : r;
   }
 
@@ -299,9 +300,9 @@ class PartGuard {
         // image: it is spread over the window rather than dropped.
         double squares = 0;
         for (int i = 0; i < count; ++i) squares += (first[i] - level) * (first[i] - level);
+        const double surplus = value - clampedValue;
         if (value - level <= o_.peerSigmas * std::sqrt(squares / count))
-          excesses.push_back(
-              {x, y, c, value - clampedValue, spreadRadiusFor(value - clampedValue, level, noise)});
+          excesses.push_back({x, y, c, surplus, spreadRadiusFor(surplus, level, noise)});
         const double excess = clampedValue - level;
         const double cap = std::max(noise * noise, excess * excess);
         const float v = variance(x, y, c);

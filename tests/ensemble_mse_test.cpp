@@ -176,22 +176,25 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
   PixelMse out;
   out.groups = groups;
   for (int g = 0; g < groups; ++g) out.h[size_t(g)] = MseMatrix::Zero(n, n);
-  // The relative form's 1 / (μ̂² + ε), μ̂ the mean of the full-buffer outputs; 1 otherwise.
-  const auto channelWeight = [&](int qx, int qy, int c) {
+  // The relative form's 1 / (μ_f² + ε) for fold A (y^A against x^B) or B, μ_f the mean of the
+  // bases' runs of that fold; 1 otherwise.
+  const auto foldWeight = [&](int qx, int qy, int c, Image BaseOutputs::*run) {
     if (!o.relative) return 1.0;
     double mu = 0;
-    for (const BaseOutputs& b : f.bases) mu += b.full(qx, qy, c);
+    for (const BaseOutputs& b : f.bases) mu += (b.*run)(qx, qy, c);
     mu /= n;
     return 1.0 / (mu * mu + kRelMseEpsilon);
   };
-  // Σ_c Σ_i ½((y_i^A − x^B)² + (y_i^B − x^A)²), each channel weighted as the terms are.
+  // Σ_c Σ_i ½(w_A (y_i^A − x^B)² + w_B (y_i^B − x^A)²).
   const auto traceAt = [&](int qx, int qy) {
     double trace = 0;
     for (int c = 0; c < 3; ++c) {
       const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
+      const double wA = foldWeight(qx, qy, c, &BaseOutputs::a);
+      const double wB = foldWeight(qx, qy, c, &BaseOutputs::b);
       for (const BaseOutputs& b : f.bases)
-        trace += channelWeight(qx, qy, c) * 0.5 *
-                 (std::pow(b.a(qx, qy, c) - xB, 2) + std::pow(b.b(qx, qy, c) - xA, 2));
+        trace +=
+            0.5 * (wA * std::pow(b.a(qx, qy, c) - xB, 2) + wB * std::pow(b.b(qx, qy, c) - xA, 2));
     }
     return trace;
   };
@@ -222,15 +225,18 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
     for (int c = 0; c < 3; ++c) {
       const int g = groups == 3 ? c : 0;
       const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
-      const double weight = cap * channelWeight(qx, qy, c);
+      const double wA = cap * foldWeight(qx, qy, c, &BaseOutputs::a);
+      const double wB = cap * foldWeight(qx, qy, c, &BaseOutputs::b);
       for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
           const double yAi = f.bases[size_t(i)].a(qx, qy, c), yAj = f.bases[size_t(j)].a(qx, qy, c);
           const double yBi = f.bases[size_t(i)].b(qx, qy, c), yBj = f.bases[size_t(j)].b(qx, qy, c);
-          // The paper's form: ⟨M⟩^A = y^A y^Aᵀ − x^B (1 y^Aᵀ + y^A 1ᵀ) + x^A x^B 11ᵀ.
-          const double mA = yAi * yAj - xB * (yAi + yAj) + xA * xB;
-          const double mB = yBi * yBj - xA * (yBi + yBj) + xA * xB;
-          t[size_t(g)](i, j) += weight * 0.5 * (mA + mB);
+          // The paper's form with equal weights: ⟨M⟩^A = y^A y^Aᵀ − x^B (1 y^Aᵀ + y^A 1ᵀ) +
+          // x^A x^B 11ᵀ, i.e. e^A e^Aᵀ minus the comparators' noise ½(x^A − x^B)²; each fold
+          // weighted by its own w, the noise by their mean.
+          const double eA = (yAi - xB) * (yAj - xB), eB = (yBi - xA) * (yBj - xA);
+          t[size_t(g)](i, j) +=
+              0.5 * (wA * eA + wB * eB) - 0.5 * (wA + wB) * 0.5 * (xA - xB) * (xA - xB);
         }
     }
     return t;
@@ -307,6 +313,11 @@ TEST(MseEstimate, MatchesTheDefinition) {
 // estimate judges, averaged over the same window (the windowed estimate is unbiased for the
 // window's average error, not for the centre pixel's): for the halves
 // ½((y^A − μ)(y^A − μ)ᵀ + (y^B − μ)(y^B − μ)ᵀ), for the quarters ¼ Σ_k (y^(−k) − μ)(y^(−k) − μ)ᵀ.
+// Relative (o.relative): each fold's term divided by μ_f² + 0.01, μ_f the mean of that fold's
+// runs over the bases, and the deviation taken up to a multiple of 11ᵀ (its mean over the
+// entries subtracted): on {Σw = 1}, wᵀ(c·11ᵀ)w = c changes no weight, while any other term
+// does. The common term itself is weighted by the folds' mean weight, which depends on every
+// fold's runs, so it is not claimed unbiased.
 std::vector<double> meanDeviation(const Fixture& f, const MseOptions& o) {
   const MseEstimator estimator(f.guides, pointers(f), o);
   const int n = 3, w = f.truth.width(), h = f.truth.height(), r = o.windowRadius;
@@ -322,8 +333,12 @@ std::vector<double> meanDeviation(const Fixture& f, const MseOptions& o) {
   const auto trueEntry = [&](int x, int y, int c, int i, int j) {
     const double mu = f.truth(x, y, c);
     double sum = 0;
-    for (size_t k = 0; k < runs[size_t(i)].size(); ++k)
-      sum += ((*runs[size_t(i)][k])(x, y, c) - mu) * ((*runs[size_t(j)][k])(x, y, c) - mu);
+    for (size_t k = 0; k < runs[size_t(i)].size(); ++k) {
+      double level = 0;
+      for (int b = 0; b < n; ++b) level += (*runs[size_t(b)][k])(x, y, c) / double(n);
+      const double weight = o.relative ? 1.0 / (level * level + 0.01) : 1.0;
+      sum += weight * ((*runs[size_t(i)][k])(x, y, c) - mu) * ((*runs[size_t(j)][k])(x, y, c) - mu);
+    }
     return sum / double(runs[size_t(i)].size());
   };
   std::vector<double> sum(size_t(n * n), 0.0);
@@ -332,7 +347,8 @@ std::vector<double> meanDeviation(const Fixture& f, const MseOptions& o) {
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       rows.pixel(x, y, m);
-      for (int c = 0; c < 3; ++c)
+      for (int c = 0; c < 3; ++c) {
+        Eigen::Matrix3d deviation;
         for (int i = 0; i < n; ++i)
           for (int j = 0; j < n; ++j) {
             double truth = 0, kernelSum = 0;
@@ -342,8 +358,12 @@ std::vector<double> meanDeviation(const Fixture& f, const MseOptions& o) {
                 truth += k * trueEntry(qx, qy, c, i, j);
                 kernelSum += k;
               }
-            sum[size_t(i * n + j)] += full(m, c)(i, j) - truth / kernelSum;
+            deviation(i, j) = full(m, c)(i, j) - truth / kernelSum;
           }
+        if (o.relative) deviation.array() -= deviation.mean();
+        for (int i = 0; i < n; ++i)
+          for (int j = 0; j < n; ++j) sum[size_t(i * n + j)] += deviation(i, j);
+      }
     }
   for (double& v : sum) v /= double(w) * h * 3;
   return sum;
@@ -352,11 +372,13 @@ std::vector<double> meanDeviation(const Fixture& f, const MseOptions& o) {
 struct BiasCheck {
   double worstZ = 0;  // largest |mean| / standard error over the entries
 };
-BiasCheck biasOverSeeds(int radius, bool leaky, MseEstimate estimate = MseEstimate::Halves) {
+BiasCheck biasOverSeeds(int radius, bool leaky, MseEstimate estimate = MseEstimate::Halves,
+                        bool relative = false, float noise = 0.3f) {
   constexpr int kSeeds = 300;
   const bool quarters = estimate == MseEstimate::Quarters;
   MseOptions o;
   o.estimate = estimate;
+  o.relative = relative;
   o.form = MseForm::PerChannel;
   o.windowRadius = radius;
   // The outlier cap weighs pixels by their own noisy terms, which trades a bias for robustness
@@ -366,7 +388,7 @@ BiasCheck biasOverSeeds(int radius, bool leaky, MseEstimate estimate = MseEstima
   o.imagePrior = 0;
   std::vector<double> sum(9, 0.0), sumSq(9, 0.0);
   for (int s = 0; s < kSeeds; ++s) {
-    Fixture f = makeFixture(16, 12, 1000 + uint64_t(s), 0.3f, quarters);
+    Fixture f = makeFixture(16, 12, 1000 + uint64_t(s), noise, quarters);
     if (leaky && quarters) {
       // The premise broken: each held-out run is the run on all four quarters, so it saw the
       // quarter it is compared with.
@@ -407,6 +429,19 @@ TEST(MseEstimate, LeaveOneQuarterOutIsUnbiasedForTheThreeQuarterRuns) {
     EXPECT_LT(biasOverSeeds(radius, false, MseEstimate::Quarters).worstZ, 3.0) << radius;
   // Negative control: held-out runs that saw their quarter.
   EXPECT_GT(biasOverSeeds(0, true, MseEstimate::Quarters).worstZ, 10.0);
+}
+
+TEST(MseEstimate, RelativeTermsAreUnbiasedUpToTheCommonTerm) {
+  // --relative and the image prior divide each fold's terms by its own runs' level (μ_f² + ε):
+  // a weight that does not see the fold's comparator keeps the estimate unbiased for what the
+  // solve sees. The level taken from the bases' blended outputs, as before 2026-12-06, saw
+  // every quarter: against its own weighted truth this statistic read z = 9–12 (halves and
+  // quarters, radius 0 and 2) for the same seeds.
+  for (MseEstimate estimate : {MseEstimate::Halves, MseEstimate::Quarters})
+    for (int radius : {0, 2})
+      EXPECT_LT(biasOverSeeds(radius, false, estimate, true).worstZ, 3.0)
+          << estimateName(estimate) << " " << radius;
+  EXPECT_GT(biasOverSeeds(0, true, MseEstimate::Quarters, true).worstZ, 10.0);
 }
 
 // The blend's estimated MSE (the mseEstimate layer) from the half blends and from the held-out
@@ -686,17 +721,21 @@ TEST(MseEstimate, ImagePriorAddsTheScaledImageMean) {
     for (int y = 0; y < h; y += stride)
       for (int x = 0; x < w; ++x)
         for (int c = 0; c < 3; ++c) {
-          double mu = 0;
-          for (const BaseOutputs& b : f.bases) mu += b.full(x, y, c) / double(n);
-          const double weight = 1.0 / (mu * mu + 0.25 * scale * scale);
+          // Each fold relative to its own runs' level (the mean over the bases of y^A, y^B).
+          double muA = 0, muB = 0;
+          for (const BaseOutputs& b : f.bases)
+            muA += b.a(x, y, c) / double(n), muB += b.b(x, y, c) / double(n);
+          const double weightA = 1.0 / (muA * muA + 0.25 * scale * scale);
+          const double weightB = 1.0 / (muB * muB + 0.25 * scale * scale);
           const double xA = f.guides.colorA(x, y, c), xB = f.guides.colorB(x, y, c);
           for (int i = 0; i < n; ++i)
             for (int j = 0; j < n; ++j)
-              mean(i, j) +=
-                  weight * 0.5 *
-                  ((f.bases[size_t(i)].a(x, y, c) - xB) * (f.bases[size_t(j)].a(x, y, c) - xB) +
-                   (f.bases[size_t(i)].b(x, y, c) - xA) * (f.bases[size_t(j)].b(x, y, c) - xA)) /
-                  double(w * rows);
+              mean(i, j) += 0.5 *
+                            (weightA * (f.bases[size_t(i)].a(x, y, c) - xB) *
+                                 (f.bases[size_t(j)].a(x, y, c) - xB) +
+                             weightB * (f.bases[size_t(i)].b(x, y, c) - xA) *
+                                 (f.bases[size_t(j)].b(x, y, c) - xA)) /
+                            double(w * rows);
         }
     const auto tangentTrace = [&](const MseMatrix& m) { return m.trace() - m.sum() / n; };
     for (double alpha : {0.5, 4.0}) {

@@ -559,6 +559,16 @@ BaseMask MseEstimator::plausibleBases(BaseMask mask, const FoldTerms& t) const {
   return inEveryFold != 0 ? inEveryFold : plausible;
 }
 
+double MseEstimator::relativeWeight(const Fold& fold, BaseMask valid, size_t ec,
+                                    double relativeEpsilon) const {
+  double mu = 0;
+  int count = 0;
+  for (int i = 0; i < baseCount_; ++i)
+    if ((valid >> i) & 1u) mu += fold.out[size_t(i)][ec], ++count;
+  mu = count > 0 ? mu / count : 0.0;
+  return 1.0 / (mu * mu + relativeEpsilon);
+}
+
 std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes,
                                                double relativeEpsilon) const {
   const bool relative = relativeEpsilon >= 0;
@@ -576,24 +586,13 @@ std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float
     std::fill(acc.begin(), acc.begin() + planeCount(), 0.0);
     for (int c = 0; c < 3; ++c) {
       const size_t ec = e + size_t(c);
-      double weight = 1.0 / (scale_ * scale_);
-      if (relative) {
-        double mu = 0;
-        int count = 0;
-        if (reference_) {
-          mu = reference_[ec], count = 1;
-        } else {
-          for (int i = 0; i < n; ++i)
-            if ((valid >> i) & 1u) mu += outFull_[size_t(i)][ec], ++count;
-        }
-        mu = count > 0 ? mu / count : 0.0;
-        weight = 1.0 / (mu * mu + relativeEpsilon);
-      }
+      const double absoluteWeight = 1.0 / (scale_ * scale_);
       double* h =
           acc.data() + size_t((options_.form == MseForm::PerChannel ? c : 0) * (entries + 1));
       if (reference_) {
         // The oracle: e = y − r, H += e eᵀ.
         const double r = reference_[ec];
+        const double weight = relative ? 1.0 / (r * r + relativeEpsilon) : absoluteWeight;
         for (int i = 0; i < n; ++i)
           first[size_t(i)] = ((valid >> i) & 1u) ? double(outFull_[size_t(i)][ec]) - r : 0.0;
         for (int i = 0, k = 0; i < n; ++i)
@@ -605,17 +604,26 @@ std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float
       // Extrapolated: 1.5 times the quarters' terms minus 0.5 times the halves'.
       const std::pair<const std::vector<Fold>*, double> groups[] = {
           {&folds_, primaryWeight_}, {&secondaryFolds_, secondaryWeight_}};
+      // Relative terms divide each fold's terms by the square of that fold's own runs' mean:
+      // a level that does not see the fold's comparator. The mean of the blended outputs
+      // (every quarter's samples) did, and weighted a fold's terms down where its comparator's
+      // noise was high, unevenly across the bases: at 4 spp it ranked bases as nearly equal
+      // that the true relative error tells apart (docs/ensemble-quality.md).
       for (const auto& [folds, groupWeight] : groups) {
         if (folds->empty()) continue;
-        const double share = groupWeight * weight / double(folds->size());
+        double weightSum = 0;
         for (const Fold& fold : *folds) {
+          const double weight =
+              relative ? relativeWeight(fold, valid, ec, relativeEpsilon) : absoluteWeight;
+          weightSum += weight;
+          const double share = groupWeight * weight / double(folds->size());
           const double x = fold.comparator[ec];
           for (int i = 0; i < n; ++i)
             first[size_t(i)] = ((valid >> i) & 1u) ? double(fold.out[size_t(i)][ec]) - x : 0.0;
           for (int i = 0, k = 0; i < n; ++i)
             for (int j = i; j < n; ++j, ++k) h[k] += share * first[size_t(i)] * first[size_t(j)];
         }
-        h[entries] -= groupWeight * weight * comparatorNoise(*folds, ec);
+        h[entries] -= groupWeight * weightSum / double(folds->size()) * comparatorNoise(*folds, ec);
       }
     }
     if (options_.outlierCap > 0 && !reference_) {

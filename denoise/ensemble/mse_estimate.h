@@ -28,9 +28,13 @@
 //   0 = per pixel, as in the paper. Accumulating keeps the estimate unbiased (up to the
 //   normalisation by Σk, which does not change the minimiser) and averages out the noise of
 //   x^A, x^B, which otherwise dominates the per-pixel choice (README: evidence).
-// - relative: divide each channel's terms by (μ̂² + ε), μ̂ = the mean of the finite bases'
-//   full-buffer outputs (the oracle: the reference), ε = 0.01, so that the objective targets
-//   relMSE instead of MSE.
+// - relative: divide each fold's terms by (μ_f² + ε), μ_f = the mean of the finite bases' runs
+//   of that fold (y^A, y^B or y^(−k); the oracle: the reference), ε = 0.01, so that the
+//   objective targets relMSE instead of MSE. The fold's own runs do not see its comparator;
+//   a level from the blended outputs did, and biased the ranking of the bases (z = 9–12 in
+//   RelativeTermsAreUnbiasedUpToTheCommonTerm; at 4 spp it weighted RDFC and à-trous nearly
+//   alike where the truth gives RDFC 0.85). The comparators' noise is weighted by the folds'
+//   mean weight.
 // - outlierCap F: before the window, scale each pixel's terms by F / (t + F), t their trace
 //   (Σ_i H_ii over the groups) in units of the larger of (mean |x|)² and the 95th percentile
 //   of the image's traces (relative form: relative units). A typical pixel keeps about its
@@ -60,8 +64,8 @@
 //   on 4 spp, README). Applied after the consistency test; as that one, a mask of the solve
 //   only.
 // - imagePrior α (0 = off): add to each pixel's (windowed) H the image-wide mean Ḡ of the
-//   per-pixel terms in relative units (divided by μ̂² + (mean |x|/2)², so that it does not
-//   depend on the unit of radiance), scaled to the same trace on the tangent space {Σv = 0}
+//   per-pixel terms in relative units (each fold's divided by μ_f² + (mean |x|/2)², so that it does
+//   not depend on the unit of radiance), scaled to the same trace on the tangent space {Σv = 0}
 //   (the part of H the solve sees) and times α: H + α·(τ(H)/τ(Ḡ))·Ḡ. Shrinkage towards the
 //   blend that is best over the whole image: a window holds ~100 pixels whose noisy halves, at
 //   a few samples per pixel, cannot rank bases that differ by less than their noise, while the
@@ -212,7 +216,8 @@ class MseEstimator {
                const MseOptions& options, const Image* reference);
   // Per-pixel (unwindowed) planes for rows [y0, y1); returns per pixel the bases whose entries
   // it holds (finite there; 0: the pixel holds nothing, e.g. a non-finite noisy comparator).
-  // relativeEpsilon < 0: absolute units (divided by scale²); else divided by μ̂² + relativeEpsilon.
+  // relativeEpsilon < 0: absolute units (divided by scale²); else each fold's divided by
+  // μ_f² + relativeEpsilon (relativeWeight).
   std::vector<BaseMask> pixelTerms(int y0, int y1, std::vector<float>& planes,
                                    double relativeEpsilon) const;
   double objectiveEpsilon() const;
@@ -242,6 +247,9 @@ class MseEstimator {
   // over the folds: ½(x^A − x^B)² for the halves.
   double comparatorNoise(size_t valueIndex) const;
   static double comparatorNoise(const std::vector<Fold>& folds, size_t valueIndex);
+  // 1 / (μ_f² + ε) at one value index, μ_f the mean of the fold's runs of the bases in `valid`.
+  double relativeWeight(const Fold& fold, BaseMask valid, size_t valueIndex,
+                        double relativeEpsilon) const;
   // Per base of a mask at a pixel: each fold's own error term t_f,i = Σ_c (y_i^f − x_f)², and
   // the allowances the tests compare them with.
   struct FoldTerms {

@@ -198,8 +198,8 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
     }
     return trace;
   };
-  // outlierCap F scales each pixel's terms by F / (tr H (all groups) / u + F): u = 1 for the
-  // relative form, else the larger of the mean |x^A|, |x^B| squared and the 95th percentile of
+  // outlierCap F scales each pixel's terms by F / (tr H (all groups) / u + F): u the larger of
+  // 1 (relative form) or the mean |x^A|, |x^B| squared (absolute) and the 95th percentile of
   // the image's per-pixel traces (every pixel: the fixture is far below 512 rows).
   double unit = 1.0;
   if (!o.relative) {
@@ -207,13 +207,12 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
     for (const Image* image : {&f.guides.colorA, &f.guides.colorB})
       for (float v : image->values()) sum += std::abs(v);
     unit = std::pow(sum / double(2 * f.truth.size()), 2);
-    std::vector<double> traces;
-    for (int qy = 0; qy < h; ++qy)
-      for (int qx = 0; qx < w; ++qx) traces.push_back(traceAt(qx, qy));
-    std::sort(traces.begin(), traces.end());
-    unit =
-        std::max(unit, traces[std::min(traces.size() - 1, size_t(0.95 * double(traces.size())))]);
   }
+  std::vector<double> traces;
+  for (int qy = 0; qy < h; ++qy)
+    for (int qx = 0; qx < w; ++qx) traces.push_back(traceAt(qx, qy));
+  std::sort(traces.begin(), traces.end());
+  unit = std::max(unit, traces[std::min(traces.size() - 1, size_t(0.95 * double(traces.size())))]);
   // One pixel's terms (every group), capped, before the window.
   const auto terms = [&](int qx, int qy) {
     std::array<MseMatrix, 3> t;
@@ -712,53 +711,64 @@ TEST(MseEstimate, NoBasePlausibleWhereEveryBaseIsFarFromBothHalves) {
 // The prior's mean is over every k-th row, k = ⌊h / 256⌋ (every row below 512 rows; the image
 // at 6 × 1100 reads rows 0, 4, 8, …), the radiance scale over every pixel.
 TEST(MseEstimate, ImagePriorAddsTheScaledImageMean) {
-  for (const auto& [w, h] : {std::pair{14, 11}, std::pair{6, 1100}}) {
-    const Fixture f = makeFixture(w, h, 8);
-    const int n = 3, stride = std::max(1, h / 256);
-    const double scale = meanAbsOfHalves(f);
-    MseMatrix mean = MseMatrix::Zero(n, n);
-    const int rows = (h + stride - 1) / stride;
-    for (int y = 0; y < h; y += stride)
-      for (int x = 0; x < w; ++x)
-        for (int c = 0; c < 3; ++c) {
-          // Each fold relative to its own runs' level (the mean over the bases of y^A, y^B).
-          double muA = 0, muB = 0;
-          for (const BaseOutputs& b : f.bases)
-            muA += b.a(x, y, c) / double(n), muB += b.b(x, y, c) / double(n);
-          const double weightA = 1.0 / (muA * muA + 0.25 * scale * scale);
-          const double weightB = 1.0 / (muB * muB + 0.25 * scale * scale);
-          const double xA = f.guides.colorA(x, y, c), xB = f.guides.colorB(x, y, c);
-          for (int i = 0; i < n; ++i)
-            for (int j = 0; j < n; ++j)
-              mean(i, j) += 0.5 *
-                            (weightA * (f.bases[size_t(i)].a(x, y, c) - xB) *
-                                 (f.bases[size_t(j)].a(x, y, c) - xB) +
-                             weightB * (f.bases[size_t(i)].b(x, y, c) - xA) *
-                                 (f.bases[size_t(j)].b(x, y, c) - xA)) /
-                            double(w * rows);
+  for (const auto& [w, h] : {std::pair{14, 11}, std::pair{6, 1100}})
+    for (double cap : {0.0, 0.5}) {
+      const Fixture f = makeFixture(w, h, 8);
+      const int n = 3, stride = std::max(1, h / 256);
+      const double scale = meanAbsOfHalves(f);
+      // Every stride-th row's relative terms: each fold relative to its own runs' level (the
+      // mean over the bases of y^A, y^B), knee (mean |x| / 2)².
+      std::vector<MseMatrix> terms;
+      std::vector<double> traces;
+      for (int y = 0; y < h; y += stride)
+        for (int x = 0; x < w; ++x) {
+          MseMatrix t = MseMatrix::Zero(n, n);
+          for (int c = 0; c < 3; ++c) {
+            double muA = 0, muB = 0;
+            for (const BaseOutputs& b : f.bases)
+              muA += b.a(x, y, c) / double(n), muB += b.b(x, y, c) / double(n);
+            const double weightA = 1.0 / (muA * muA + 0.25 * scale * scale);
+            const double weightB = 1.0 / (muB * muB + 0.25 * scale * scale);
+            const double xA = f.guides.colorA(x, y, c), xB = f.guides.colorB(x, y, c);
+            for (int i = 0; i < n; ++i)
+              for (int j = 0; j < n; ++j)
+                t(i, j) += 0.5 * (weightA * (f.bases[size_t(i)].a(x, y, c) - xB) *
+                                      (f.bases[size_t(j)].a(x, y, c) - xB) +
+                                  weightB * (f.bases[size_t(i)].b(x, y, c) - xA) *
+                                      (f.bases[size_t(j)].b(x, y, c) - xA));
+          }
+          terms.push_back(t);
+          traces.push_back(t.trace());
         }
-    const auto tangentTrace = [&](const MseMatrix& m) { return m.trace() - m.sum() / n; };
-    for (double alpha : {0.5, 4.0}) {
-      MseOptions with, without;
-      with.windowRadius = without.windowRadius = 2;
-      with.outlierCap = without.outlierCap = 0;
-      with.imagePrior = alpha;
-      without.imagePrior = 0;
-      const MseEstimator a(f.guides, pointers(f), with), b(f.guides, pointers(f), without);
-      for (int y = 0; y<h; y += h> 100 ? 97 : 2)
-        for (int x = 0; x < w; x += 3) {
-          const MseMatrix local = b.at(x, y).h[0];
-          const MseMatrix expected =
-              local + alpha * tangentTrace(local) / tangentTrace(mean) * mean;
-          const MseMatrix got = a.at(x, y).h[0];
-          for (int i = 0; i < n; ++i)
-            for (int j = 0; j < n; ++j)
-              EXPECT_NEAR(got(i, j), expected(i, j), 1e-4 * expected.cwiseAbs().maxCoeff())
-                  << w << "x" << h << ", " << alpha << " at " << x << "," << y << " entry " << i
-                  << "," << j;
-        }
+      // The outlier cap F / (trace / u + F), u the larger of 1 and the traces' 95th percentile.
+      std::vector<double> sorted = traces;
+      std::sort(sorted.begin(), sorted.end());
+      const double unit = std::max(1.0, sorted[size_t(0.95 * double(sorted.size()))]);
+      MseMatrix mean = MseMatrix::Zero(n, n);
+      for (size_t p = 0; p < terms.size(); ++p)
+        mean += (cap > 0 ? cap / (traces[p] / unit + cap) : 1.0) * terms[p] / double(terms.size());
+      const auto tangentTrace = [&](const MseMatrix& m) { return m.trace() - m.sum() / n; };
+      for (double alpha : {0.5, 4.0}) {
+        MseOptions with, without;
+        with.windowRadius = without.windowRadius = 2;
+        with.outlierCap = without.outlierCap = cap;
+        with.imagePrior = alpha;
+        without.imagePrior = 0;
+        const MseEstimator a(f.guides, pointers(f), with), b(f.guides, pointers(f), without);
+        for (int y = 0; y<h; y += h> 100 ? 97 : 2)
+          for (int x = 0; x < w; x += 3) {
+            const MseMatrix local = b.at(x, y).h[0];
+            const MseMatrix expected =
+                local + alpha * tangentTrace(local) / tangentTrace(mean) * mean;
+            const MseMatrix got = a.at(x, y).h[0];
+            for (int i = 0; i < n; ++i)
+              for (int j = 0; j < n; ++j)
+                EXPECT_NEAR(got(i, j), expected(i, j), 1e-4 * expected.cwiseAbs().maxCoeff())
+                    << w << "x" << h << ", cap " << cap << ", " << alpha << " at " << x << "," << y
+                    << " entry " << i << "," << j;
+          }
+      }
     }
-  }
 }
 
 TEST(MseEstimate, ExtremeScales) {

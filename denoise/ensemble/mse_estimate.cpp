@@ -244,8 +244,11 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
                       for (size_t p = range.begin(); p < range.end(); ++p)
                         validity_[p] = computeValidAt(p);
                     });
-  if (options.outlierCap > 0 && !reference_ && !options.relative)
-    capUnit_ = std::max(1.0, typicalTrace());
+  if (options.outlierCap > 0 && !reference_) {
+    if (!options.relative) capUnit_ = std::max(1.0, typicalTrace(-1.0));
+    if (options.relative) relativeCapUnit_ = std::max(1.0, typicalTrace(objectiveEpsilon()));
+    if (options.imagePrior > 0) priorCapUnit_ = std::max(1.0, typicalTrace(priorEpsilon()));
+  }
   if (options.imagePrior > 0 && !reference_) imagePrior_ = imagePriorTerms();
 }
 
@@ -255,7 +258,11 @@ int MseEstimator::sampleStride() const {
   return std::max(1, height_ / kPriorRows);
 }
 
-double MseEstimator::typicalTrace() const {
+double MseEstimator::priorEpsilon() const {
+  return 0.25 * scale_ * scale_;
+}
+
+double MseEstimator::typicalTrace(double relativeEpsilon) const {
   const int stride = sampleStride();
   const int rows = (height_ + stride - 1) / stride;
   std::vector<std::vector<double>> perRow(static_cast<size_t>(rows));
@@ -265,12 +272,25 @@ double MseEstimator::typicalTrace() const {
       const size_t p = y * size_t(width_) + size_t(x);
       const BaseMask valid = validAt(p);
       if (valid == 0 || !comparatorsFinite(p)) continue;
-      // Σ_i H_ii before the cap: every base's own error term d_i.
-      const FoldTerms terms = foldTermsAt(p, valid);
+      // Σ_i H_ii before the cap: every base's own error term d_i, in the terms' units.
       double trace = 0;
-      for (int i = 0; i < baseCount_; ++i)
-        if ((valid >> i) & 1u) trace += terms.mean(i);
-      trace /= scale_ * scale_;
+      if (relativeEpsilon < 0) {
+        const FoldTerms terms = foldTermsAt(p, valid);
+        for (int i = 0; i < baseCount_; ++i)
+          if ((valid >> i) & 1u) trace += terms.mean(i);
+        trace /= scale_ * scale_;
+      } else {
+        for (const Fold& fold : folds_)
+          for (int c = 0; c < 3; ++c) {
+            const size_t ec = p * 3 + size_t(c);
+            const double weight = relativeWeight(fold, valid, ec, relativeEpsilon);
+            for (int i = 0; i < baseCount_; ++i) {
+              if (!((valid >> i) & 1u)) continue;
+              const double d = double(fold.out[size_t(i)][ec]) - fold.comparator[ec];
+              trace += weight * d * d / double(folds_.size());
+            }
+          }
+      }
       if (std::isfinite(trace)) perRow[size_t(row)].push_back(trace);
     }
   });
@@ -287,7 +307,7 @@ void MseEstimator::addPriorRow(int y, std::vector<float>& planes, std::vector<do
   const int n = baseCount_, entries = this->entries();
   // Relative to μ̂² + (mean |x| / 2)²: every region counts by its relative error, as in relMSE,
   // but with a knee that follows the image's brightness, not its unit.
-  const std::vector<BaseMask> present = pixelTerms(y, y + 1, planes, 0.25 * scale_ * scale_);
+  const std::vector<BaseMask> present = pixelTerms(y, y + 1, planes, priorEpsilon(), priorCapUnit_);
   const size_t pixels = present.size();
   for (size_t p = 0; p < pixels; ++p) {
     const BaseMask mask = present[p];
@@ -360,6 +380,10 @@ void MseEstimator::addImagePrior(MseRows& rows) const {
       for (int k = 0; k < entries; ++k) h[size_t(k) * pixels] += float(factor * prior[k]);
     }
   }
+}
+
+double MseEstimator::objectiveCapUnit() const {
+  return options_.relative ? relativeCapUnit_ : capUnit_;
 }
 
 double MseEstimator::objectiveEpsilon() const {
@@ -570,7 +594,7 @@ double MseEstimator::relativeWeight(const Fold& fold, BaseMask valid, size_t ec,
 }
 
 std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float>& planes,
-                                               double relativeEpsilon) const {
+                                               double relativeEpsilon, double capUnit) const {
   const bool relative = relativeEpsilon >= 0;
   const int n = baseCount_, entries = this->entries();
   const size_t pixels = size_t(y1 - y0) * size_t(width_);
@@ -630,9 +654,7 @@ std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float
       double trace = 0;
       for (int g = 0; g < groups(); ++g)
         for (int i = 0; i < n; ++i) trace += acc[size_t(g * (entries + 1) + packed(i, i, n))];
-      // Relative terms (the prior's, --relative) keep their own unit.
-      const double unit = relative ? 1.0 : capUnit_;
-      const double factor = options_.outlierCap / (trace / unit + options_.outlierCap);
+      const double factor = options_.outlierCap / (trace / capUnit + options_.outlierCap);
       for (int k = 0; k < planeCount(); ++k) acc[size_t(k)] *= factor;
     }
     bool finite = true;
@@ -667,7 +689,7 @@ MseRows MseEstimator::rows(int y0, int y1) const {
 
   const int r = options_.windowRadius;
   if (r == 0) {
-    pixelTerms(y0, y1, out.planes_, objectiveEpsilon());
+    pixelTerms(y0, y1, out.planes_, objectiveEpsilon(), objectiveCapUnit());
     addImagePrior(out);
     return out;
   }
@@ -682,7 +704,8 @@ MseRows MseEstimator::rows(int y0, int y1) const {
   const int halo = r + step / 2;
   const int inY0 = std::max(0, y0 - halo), inY1 = std::min(height_, y1 + halo);
   std::vector<float> in;
-  const std::vector<BaseMask> present = pixelTerms(inY0, inY1, in, objectiveEpsilon());
+  const std::vector<BaseMask> present =
+      pixelTerms(inY0, inY1, in, objectiveEpsilon(), objectiveCapUnit());
   const size_t inPixels = size_t(inY1 - inY0) * size_t(width_);
   const BaseMask all = allBases(baseCount_);
   const bool holes =

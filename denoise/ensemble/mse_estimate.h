@@ -37,7 +37,9 @@
 //   mean weight.
 // - outlierCap F: before the window, scale each pixel's terms by F / (t + F), t their trace
 //   (Σ_i H_ii over the groups) in units of the larger of (mean |x|)² and the 95th percentile
-//   of the image's traces (relative form: relative units). A typical pixel keeps about its
+//   of the image's traces (relative terms, --relative's and the prior's: the larger of 1 and
+//   their own traces' percentile; at a few samples per pixel they run far above 1, and a unit
+//   of 1 scaled most pixels by their own comparator's noise). A typical pixel keeps about its
 //   weight; a firefly's terms, whose noise (the cross terms −x^A y_i^B with a huge x^A) would
 //   otherwise choose the weights of every pixel within the radius, count about as much as F.
 //   The percentile: at a few samples per pixel the comparators' noise alone puts the bright
@@ -218,8 +220,11 @@ class MseEstimator {
   // it holds (finite there; 0: the pixel holds nothing, e.g. a non-finite noisy comparator).
   // relativeEpsilon < 0: absolute units (divided by scale²); else each fold's divided by
   // μ_f² + relativeEpsilon (relativeWeight).
+  // capUnit: the outlier cap's unit in the same units (typicalTrace).
   std::vector<BaseMask> pixelTerms(int y0, int y1, std::vector<float>& planes,
-                                   double relativeEpsilon) const;
+                                   double relativeEpsilon, double capUnit) const;
+  double priorEpsilon() const;      // the prior's knee, (mean |x| / 2)²
+  double objectiveCapUnit() const;  // capUnit_ or relativeCapUnit_
   double objectiveEpsilon() const;
   BaseMask computeValidAt(size_t pixel) const;  // what validAt returns, from the images
   // The mean of the relative per-pixel terms, each entry over the pixels where both its bases
@@ -227,9 +232,10 @@ class MseEstimator {
   std::vector<double> imagePriorTerms() const;
   // The row spacing of the image-wide statistics (the prior, typicalTrace).
   int sampleStride() const;
-  // The kCapPercentile-th percentile of the per-pixel traces of the absolute terms over scale²
-  // (every sampleStride-th row; 0 when no pixel has terms): the outlier cap's unit.
-  double typicalTrace() const;
+  // The kCapPercentile-th percentile of the per-pixel traces before the cap (every
+  // sampleStride-th row; 0 when no pixel has terms): the outlier cap's unit. Absolute terms
+  // over scale² (relativeEpsilon < 0), or relative terms as pixelTerms makes them.
+  double typicalTrace(double relativeEpsilon) const;
   // Adds row y's relative per-pixel terms to the prior's sums and their pixel counts.
   void addPriorRow(int y, std::vector<float>& planes, std::vector<double>& sum,
                    std::vector<size_t>& count) const;
@@ -283,6 +289,10 @@ class MseEstimator {
   double scale_ = 1.0;  // absolute form: values are divided by scale² (scale = mean |x|)
   // The outlier cap's unit over scale²: 1, or the traces' percentile over scale² where larger.
   double capUnit_ = 1.0;
+  // The same for the relative terms: --relative's (relativeCapUnit_), the prior's
+  // (priorCapUnit_). In relative units the traces of a few-sample image run far above 1, and a
+  // cap at 1 weighted most pixels by their own comparator's noise (docs/ensemble-quality.md).
+  double relativeCapUnit_ = 1.0, priorCapUnit_ = 1.0;
   std::array<const float*, kMaxDenoisers> outFull_{};
   std::vector<Fold> folds_;           // the tests' folds and the estimate's (weight primary)
   std::vector<Fold> secondaryFolds_;  // Extrapolated: the halves (weight secondary)

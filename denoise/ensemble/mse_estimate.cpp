@@ -22,6 +22,8 @@ constexpr double kConsistencyAllowance = 0.1;
 // The outlier cap's unit is at least this percentile of the image's per-pixel traces (chosen on
 // the corpus's tuning half among 0.75, 0.9, 0.95 and 0.99: docs/ensemble-quality.md).
 constexpr double kCapPercentile = 0.95;
+// The relative terms' percentile reads every this-many of the rows the other image-wide
+// statistics read (typicalTrace).
 constexpr int kRelativeTraceRowStep = 4;
 
 // The window's colour term: guide differences within this fraction of the guide itself count as
@@ -246,8 +248,10 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
                         validity_[p] = computeValidAt(p);
                     });
   if (options.outlierCap > 0 && !reference_) {
-    if (!options.relative) capUnit_ = std::max(1.0, typicalTrace(-1.0));
-    if (options.relative) relativeCapUnit_ = std::max(1.0, typicalTrace(objectiveEpsilon()));
+    if (options.relative)
+      relativeCapUnit_ = std::max(1.0, typicalTrace(objectiveEpsilon()));
+    else
+      capUnit_ = std::max(1.0, typicalTrace(-1.0));
     if (options.imagePrior > 0) priorCapUnit_ = std::max(1.0, typicalTrace(priorEpsilon()));
   }
   if (options.imagePrior > 0 && !reference_) imagePrior_ = imagePriorTerms();
@@ -309,8 +313,8 @@ double MseEstimator::typicalTrace(double relativeEpsilon) const {
 void MseEstimator::addPriorRow(int y, std::vector<float>& planes, std::vector<double>& sum,
                                std::vector<size_t>& count) const {
   const int n = baseCount_, entries = this->entries();
-  // Relative to μ̂² + (mean |x| / 2)²: every region counts by its relative error, as in relMSE,
-  // but with a knee that follows the image's brightness, not its unit.
+  // Relative to μ_f² + (mean |x| / 2)², per fold: every region counts by its relative error, as
+  // in relMSE, but with a knee that follows the image's brightness, not its unit.
   const std::vector<BaseMask> present = pixelTerms(y, y + 1, planes, priorEpsilon(), priorCapUnit_);
   const size_t pixels = present.size();
   for (size_t p = 0; p < pixels; ++p) {

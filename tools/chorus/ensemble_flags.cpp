@@ -37,7 +37,8 @@ void EnsembleFlags::addFlags(CLI::App& cmd) {
       ->transform(finiteIn(0, kMaxEnsembleFactor))
       ->each([this](const std::string&) { windowColorGiven = true; });
   cmd.add_flag("--relative,!--absolute", relative,
-               "Divide the MSE estimate by (mean² + 0.01) so that it targets relMSE");
+               "Divide the MSE estimate by (mean² + 0.01), each fold by its own runs' mean, so "
+               "that it targets relMSE");
   cmd.add_option("--outlier-cap", outlierCap,
                  "Scale each pixel's MSE terms by F/(trace + F) before the window (trace in units "
                  "of mean|x|², or of the image's 95th-percentile trace where larger), so that a "

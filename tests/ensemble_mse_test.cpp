@@ -168,6 +168,15 @@ double windowWeight(const Fixture& f, const MseOptions& o, const WindowColor& co
   return std::exp(-d);
 }
 
+// The relative terms' 1 / (μ_f² + ε) of fold A (y^A against x^B, run = &BaseOutputs::a) or B,
+// μ_f the mean of the bases' runs of that fold.
+double foldWeight(const Fixture& f, Image BaseOutputs::*run, int x, int y, int c, double epsilon) {
+  double mu = 0;
+  for (const BaseOutputs& b : f.bases) mu += (b.*run)(x, y, c);
+  mu /= double(f.bases.size());
+  return 1.0 / (mu * mu + epsilon);
+}
+
 // ⟨M⟩ at one pixel straight from the definition, in double.
 PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
   const int n = int(f.bases.size()), w = f.truth.width(), h = f.truth.height();
@@ -176,22 +185,17 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
   PixelMse out;
   out.groups = groups;
   for (int g = 0; g < groups; ++g) out.h[size_t(g)] = MseMatrix::Zero(n, n);
-  // The relative form's 1 / (μ_f² + ε) for fold A (y^A against x^B) or B, μ_f the mean of the
-  // bases' runs of that fold; 1 otherwise.
-  const auto foldWeight = [&](int qx, int qy, int c, Image BaseOutputs::*run) {
-    if (!o.relative) return 1.0;
-    double mu = 0;
-    for (const BaseOutputs& b : f.bases) mu += (b.*run)(qx, qy, c);
-    mu /= n;
-    return 1.0 / (mu * mu + kRelMseEpsilon);
+  // The relative form's weight of fold A or B (foldWeight); 1 otherwise.
+  const auto weightOf = [&](int qx, int qy, int c, Image BaseOutputs::*run) {
+    return o.relative ? foldWeight(f, run, qx, qy, c, kRelMseEpsilon) : 1.0;
   };
   // Σ_c Σ_i ½(w_A (y_i^A − x^B)² + w_B (y_i^B − x^A)²).
   const auto traceAt = [&](int qx, int qy) {
     double trace = 0;
     for (int c = 0; c < 3; ++c) {
       const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
-      const double wA = foldWeight(qx, qy, c, &BaseOutputs::a);
-      const double wB = foldWeight(qx, qy, c, &BaseOutputs::b);
+      const double wA = weightOf(qx, qy, c, &BaseOutputs::a);
+      const double wB = weightOf(qx, qy, c, &BaseOutputs::b);
       for (const BaseOutputs& b : f.bases)
         trace +=
             0.5 * (wA * std::pow(b.a(qx, qy, c) - xB, 2) + wB * std::pow(b.b(qx, qy, c) - xA, 2));
@@ -225,8 +229,8 @@ PixelMse naiveMse(const Fixture& f, const MseOptions& o, int x, int y) {
     for (int c = 0; c < 3; ++c) {
       const int g = groups == 3 ? c : 0;
       const double xA = f.guides.colorA(qx, qy, c), xB = f.guides.colorB(qx, qy, c);
-      const double wA = cap * foldWeight(qx, qy, c, &BaseOutputs::a);
-      const double wB = cap * foldWeight(qx, qy, c, &BaseOutputs::b);
+      const double wA = cap * weightOf(qx, qy, c, &BaseOutputs::a);
+      const double wB = cap * weightOf(qx, qy, c, &BaseOutputs::b);
       for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
           const double yAi = f.bases[size_t(i)].a(qx, qy, c), yAj = f.bases[size_t(j)].a(qx, qy, c);
@@ -373,7 +377,7 @@ struct BiasCheck {
   double worstZ = 0;  // largest |mean| / standard error over the entries
 };
 BiasCheck biasOverSeeds(int radius, bool leaky, MseEstimate estimate = MseEstimate::Halves,
-                        bool relative = false, float noise = 0.3f) {
+                        bool relative = false) {
   constexpr int kSeeds = 300;
   const bool quarters = estimate == MseEstimate::Quarters;
   MseOptions o;
@@ -388,7 +392,7 @@ BiasCheck biasOverSeeds(int radius, bool leaky, MseEstimate estimate = MseEstima
   o.imagePrior = 0;
   std::vector<double> sum(9, 0.0), sumSq(9, 0.0);
   for (int s = 0; s < kSeeds; ++s) {
-    Fixture f = makeFixture(16, 12, 1000 + uint64_t(s), noise, quarters);
+    Fixture f = makeFixture(16, 12, 1000 + uint64_t(s), 0.3f, quarters);
     if (leaky && quarters) {
       // The premise broken: each held-out run is the run on all four quarters, so it saw the
       // quarter it is compared with.
@@ -725,11 +729,8 @@ TEST(MseEstimate, ImagePriorAddsTheScaledImageMean) {
         for (int x = 0; x < w; ++x) {
           MseMatrix t = MseMatrix::Zero(n, n);
           for (int c = 0; c < 3; ++c) {
-            double muA = 0, muB = 0;
-            for (const BaseOutputs& b : f.bases)
-              muA += b.a(x, y, c) / double(n), muB += b.b(x, y, c) / double(n);
-            const double weightA = 1.0 / (muA * muA + 0.25 * scale * scale);
-            const double weightB = 1.0 / (muB * muB + 0.25 * scale * scale);
+            const double weightA = foldWeight(f, &BaseOutputs::a, x, y, c, 0.25 * scale * scale);
+            const double weightB = foldWeight(f, &BaseOutputs::b, x, y, c, 0.25 * scale * scale);
             const double xA = f.guides.colorA(x, y, c), xB = f.guides.colorB(x, y, c);
             for (int i = 0; i < n; ++i)
               for (int j = 0; j < n; ++j)

@@ -248,10 +248,7 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
                         validity_[p] = computeValidAt(p);
                     });
   if (options.outlierCap > 0 && !reference_) {
-    if (options.relative)
-      relativeCapUnit_ = std::max(1.0, typicalTrace(objectiveEpsilon()));
-    else
-      capUnit_ = std::max(1.0, typicalTrace(-1.0));
+    capUnit_ = std::max(1.0, typicalTrace(objectiveEpsilon()));
     if (options.imagePrior > 0) priorCapUnit_ = std::max(1.0, typicalTrace(priorEpsilon()));
   }
   if (options.imagePrior > 0 && !reference_) imagePrior_ = imagePriorTerms();
@@ -280,25 +277,8 @@ double MseEstimator::typicalTrace(double relativeEpsilon) const {
       const size_t p = y * size_t(width_) + size_t(x);
       const BaseMask valid = validAt(p);
       if (valid == 0 || !comparatorsFinite(p)) continue;
-      // Σ_i H_ii before the cap: every base's own error term d_i, in the terms' units.
-      double trace = 0;
-      if (relativeEpsilon < 0) {
-        const FoldTerms terms = foldTermsAt(p, valid);
-        for (int i = 0; i < baseCount_; ++i)
-          if ((valid >> i) & 1u) trace += terms.mean(i);
-        trace /= scale_ * scale_;
-      } else {
-        for (const Fold& fold : folds_)
-          for (int c = 0; c < 3; ++c) {
-            const size_t ec = p * 3 + size_t(c);
-            const double weight = relativeWeight(fold, valid, ec, relativeEpsilon);
-            for (int i = 0; i < baseCount_; ++i) {
-              if (!((valid >> i) & 1u)) continue;
-              const double d = double(fold.out[size_t(i)][ec]) - fold.comparator[ec];
-              trace += weight * d * d / double(folds_.size());
-            }
-          }
-      }
+      const double trace =
+          relativeEpsilon < 0 ? absoluteTrace(p, valid) : relativeTrace(p, valid, relativeEpsilon);
       if (std::isfinite(trace)) perRow[size_t(row)].push_back(trace);
     }
   });
@@ -308,6 +288,29 @@ double MseEstimator::typicalTrace(double relativeEpsilon) const {
   const size_t k = std::min(traces.size() - 1, size_t(kCapPercentile * double(traces.size())));
   std::nth_element(traces.begin(), traces.begin() + std::ptrdiff_t(k), traces.end());
   return traces[k];
+}
+
+double MseEstimator::absoluteTrace(size_t p, BaseMask valid) const {
+  const FoldTerms terms = foldTermsAt(p, valid);
+  double trace = 0;
+  for (int i = 0; i < baseCount_; ++i)
+    if ((valid >> i) & 1u) trace += terms.mean(i);
+  return trace / (scale_ * scale_);
+}
+
+double MseEstimator::relativeTrace(size_t p, BaseMask valid, double relativeEpsilon) const {
+  double trace = 0;
+  for (const Fold& fold : folds_)
+    for (int c = 0; c < 3; ++c) {
+      const size_t ec = p * 3 + size_t(c);
+      const double weight = relativeWeight(fold, valid, ec, relativeEpsilon);
+      for (int i = 0; i < baseCount_; ++i) {
+        if (!((valid >> i) & 1u)) continue;
+        const double d = double(fold.out[size_t(i)][ec]) - fold.comparator[ec];
+        trace += weight * d * d / double(folds_.size());
+      }
+    }
+  return trace;
 }
 
 void MseEstimator::addPriorRow(int y, std::vector<float>& planes, std::vector<double>& sum,
@@ -388,10 +391,6 @@ void MseEstimator::addImagePrior(MseRows& rows) const {
       for (int k = 0; k < entries; ++k) h[size_t(k) * pixels] += float(factor * prior[k]);
     }
   }
-}
-
-double MseEstimator::objectiveCapUnit() const {
-  return options_.relative ? relativeCapUnit_ : capUnit_;
 }
 
 double MseEstimator::objectiveEpsilon() const {
@@ -610,6 +609,7 @@ std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float
   std::vector<BaseMask> present(pixels, 0);
   std::array<double, 3 * ((kMaxDenoisers * (kMaxDenoisers + 1)) / 2 + 1)> acc{};
   std::array<double, kMaxDenoisers> first{};
+  const double absoluteWeight = 1.0 / (scale_ * scale_);
   for (size_t local = 0; local < pixels; ++local) {
     const size_t q = size_t(y0) * size_t(width_) + local;
     const size_t e = q * 3;
@@ -618,7 +618,6 @@ std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float
     std::fill(acc.begin(), acc.begin() + planeCount(), 0.0);
     for (int c = 0; c < 3; ++c) {
       const size_t ec = e + size_t(c);
-      const double absoluteWeight = 1.0 / (scale_ * scale_);
       double* h =
           acc.data() + size_t((options_.form == MseForm::PerChannel ? c : 0) * (entries + 1));
       if (reference_) {
@@ -697,7 +696,7 @@ MseRows MseEstimator::rows(int y0, int y1) const {
 
   const int r = options_.windowRadius;
   if (r == 0) {
-    pixelTerms(y0, y1, out.planes_, objectiveEpsilon(), objectiveCapUnit());
+    pixelTerms(y0, y1, out.planes_, objectiveEpsilon(), capUnit_);
     addImagePrior(out);
     return out;
   }
@@ -712,8 +711,7 @@ MseRows MseEstimator::rows(int y0, int y1) const {
   const int halo = r + step / 2;
   const int inY0 = std::max(0, y0 - halo), inY1 = std::min(height_, y1 + halo);
   std::vector<float> in;
-  const std::vector<BaseMask> present =
-      pixelTerms(inY0, inY1, in, objectiveEpsilon(), objectiveCapUnit());
+  const std::vector<BaseMask> present = pixelTerms(inY0, inY1, in, objectiveEpsilon(), capUnit_);
   const size_t inPixels = size_t(inY1 - inY0) * size_t(width_);
   const BaseMask all = allBases(baseCount_);
   const bool holes =

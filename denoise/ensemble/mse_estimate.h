@@ -220,11 +220,10 @@ class MseEstimator {
   // it holds (finite there; 0: the pixel holds nothing, e.g. a non-finite noisy comparator).
   // relativeEpsilon < 0: absolute units (divided by scale²); else each fold's divided by
   // μ_f² + relativeEpsilon (relativeWeight).
-  // capUnit: the outlier cap's unit in the same units (typicalTrace).
+  // capUnit: the outlier cap's unit in the same units (capUnit_ or priorCapUnit_).
   std::vector<BaseMask> pixelTerms(int y0, int y1, std::vector<float>& planes,
                                    double relativeEpsilon, double capUnit) const;
-  double priorEpsilon() const;      // the prior's knee, (mean |x| / 2)²
-  double objectiveCapUnit() const;  // capUnit_ or relativeCapUnit_
+  double priorEpsilon() const;  // the prior's knee, (mean |x| / 2)²
   double objectiveEpsilon() const;
   BaseMask computeValidAt(size_t pixel) const;  // what validAt returns, from the images
   // The mean of the relative per-pixel terms, each entry over the pixels where both its bases
@@ -236,6 +235,9 @@ class MseEstimator {
   // sampleStride-th row; 0 when no pixel has terms): the outlier cap's unit. Absolute terms
   // over scale² (relativeEpsilon < 0), or relative terms as pixelTerms makes them.
   double typicalTrace(double relativeEpsilon) const;
+  // One pixel's Σ_i H_ii before the cap: over scale², or relative (each fold by relativeWeight).
+  double absoluteTrace(size_t pixel, BaseMask valid) const;
+  double relativeTrace(size_t pixel, BaseMask valid, double relativeEpsilon) const;
   // Adds row y's relative per-pixel terms to the prior's sums and their pixel counts.
   void addPriorRow(int y, std::vector<float>& planes, std::vector<double>& sum,
                    std::vector<size_t>& count) const;
@@ -287,12 +289,12 @@ class MseEstimator {
   MseOptions options_;
   int width_ = 0, height_ = 0, baseCount_ = 0;
   double scale_ = 1.0;  // absolute form: values are divided by scale² (scale = mean |x|)
-  // The outlier cap's unit over scale²: 1, or the traces' percentile over scale² where larger.
-  double capUnit_ = 1.0;
-  // The same for the relative terms: --relative's (relativeCapUnit_), the prior's
-  // (priorCapUnit_). In relative units the traces of a few-sample image run far above 1, and a
-  // cap at 1 weighted most pixels by their own comparator's noise (docs/ensemble-quality.md).
-  double relativeCapUnit_ = 1.0, priorCapUnit_ = 1.0;
+  // The outlier cap's unit in the objective's terms' units (over scale², or relative with
+  // --relative): 1, or the traces' percentile where larger; priorCapUnit_ the same for the
+  // prior's relative terms. In relative units the traces of a few-sample image run far above
+  // 1, and a unit of 1 weighted most pixels by their own comparator's noise
+  // (docs/ensemble-quality.md).
+  double capUnit_ = 1.0, priorCapUnit_ = 1.0;
   std::array<const float*, kMaxDenoisers> outFull_{};
   std::vector<Fold> folds_;           // the tests' folds and the estimate's (weight primary)
   std::vector<Fold> secondaryFolds_;  // Extrapolated: the halves (weight secondary)

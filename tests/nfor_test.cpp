@@ -2,6 +2,7 @@
 // including 4 spp quarters (one sample each, so the variance falls back to the two-buffer
 // estimate), constant and black images, determinism, non-finite inputs, registry.
 #include "denoise/base/nfor/nfor.h"
+#include "denoise/base/nfor/selection_knee.h"
 
 #include <gtest/gtest.h>
 
@@ -91,10 +92,41 @@ TEST(Nfor, NonFiniteAndExtremeInputsGiveFiniteOutputs) {
   });
 }
 
+// The selection's knee (selection_knee.h), on numbers worked by hand: an image whose mean |colour|
+// is 1, knee 16: a pixel at level 8 keeps its errors, one at 64 (or −64) has them divided by
+// (64 / 16)² = 16, in both maps; knee 0 changes nothing; scaling colour and level by s and the
+// errors by s² scales the result by s² (the selection does not depend on the unit of radiance).
+TEST(Nfor, SelectionKneePutsBrightPixelsOnTheRelativeScale) {
+  Image colour(4, 1, 1), level(4, 1, 1), mse0(4, 1, 1), mse1(4, 1, 1);
+  const float c[4] = {0.5f, 1.5f, -1.0f, 1.0f}, l[4] = {8.0f, 64.0f, -64.0f, 16.0f};
+  const float e0[4] = {3.0f, 32.0f, 160.0f, 5.0f}, e1[4] = {-1.0f, 48.0f, 16.0f, 7.0f};
+  const auto fill = [&](double s) {
+    for (int x = 0; x < 4; ++x) {
+      colour(x, 0, 0) = float(c[x] * s);
+      level(x, 0, 0) = float(l[x] * s);
+      mse0(x, 0, 0) = float(e0[x] * s * s);
+      mse1(x, 0, 0) = float(e1[x] * s * s);
+    }
+  };
+  const float expected0[4] = {3.0f, 2.0f, 10.0f, 5.0f}, expected1[4] = {-1.0f, 3.0f, 1.0f, 7.0f};
+  for (double s : {1.0, 1e-15, 1e15}) {
+    fill(s);
+    kneeBrightErrors(mse0, mse1, colour, level, 16.0f);
+    for (int x = 0; x < 4; ++x) {
+      EXPECT_NEAR(mse0(x, 0, 0) / (s * s), expected0[x], 1e-5 * std::abs(expected0[x])) << x;
+      EXPECT_NEAR(mse1(x, 0, 0) / (s * s), expected1[x], 1e-5 * std::abs(expected1[x])) << x;
+    }
+  }
+  fill(1.0);
+  kneeBrightErrors(mse0, mse1, colour, level, 0.0f);
+  for (int x = 0; x < 4; ++x) EXPECT_EQ(mse0(x, 0, 0), e0[x]);
+}
+
 TEST(Nfor, RequirementsRegistryAndParameters) {
-  test::expectCreates("nfor:k1=0.4:k2=1.2:regressionR=7", "nfor",
+  test::expectCreates("nfor:k1=0.4:k2=1.2:regressionR=7:selectionKnee=0", "nfor",
                       {.features = true, .halves = true});
-  test::expectRejected({"nfor:bandwidth=1", "nfor:k1=0", "nfor:regressionR=-1"});
+  test::expectRejected(
+      {"nfor:bandwidth=1", "nfor:k1=0", "nfor:regressionR=-1", "nfor:selectionKnee=-1"});
   test::expectNeedsHalves(NforDenoiser());
 }
 

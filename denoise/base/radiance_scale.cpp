@@ -12,7 +12,7 @@
 namespace chorus {
 namespace {
 
-constexpr float kMaxFloat = std::numeric_limits<float>::max();
+constexpr float kSaturatedFloat = std::numeric_limits<float>::max();
 constexpr float kMinFloat = std::numeric_limits<float>::min();
 
 // The exponent of the least power of two ≥ value / 2^limit (0 when value is within the limit).
@@ -106,9 +106,9 @@ void scaleColor(DenoiseInput& input, int exponent) {
     const Image* fallback = nullptr;
     for (size_t i = 0; i < variance.size(); ++i) {
       float& v = variance.data()[i];
-      const bool saturated = v >= kMaxFloat;  // also +Inf; NaN stays NaN
+      const bool saturated = v >= kSaturatedFloat;  // also +Inf; NaN stays NaN
       const bool underflowed = exponent > 0 && v >= 0.0f && v < kMinFloat && mean.data()[i] != 0;
-      v = std::ldexp(saturated ? kMaxFloat : v, 2 * exponent);
+      v = std::ldexp(saturated ? kSaturatedFloat : v, 2 * exponent);
       if (!saturated && !underflowed) continue;
       if (!fallback) fallback = estimate(whole);
       if (fallback && std::isfinite(fallback->data()[i])) v = std::max(v, fallback->data()[i]);
@@ -122,7 +122,8 @@ void scaleColor(DenoiseInput& input, int exponent) {
 
 void scaleImage(Image& image, int exponent) {
   if (exponent == 0) return;
-  for (float& v : image.values()) v = std::clamp(std::ldexp(v, exponent), -kMaxFloat, kMaxFloat);
+  for (float& v : image.values())
+    v = std::clamp(std::ldexp(v, exponent), -kSaturatedFloat, kSaturatedFloat);
 }
 
 }  // namespace chorus

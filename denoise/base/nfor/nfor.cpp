@@ -11,6 +11,7 @@
 #include "denoise/base/filters/local_range.h"
 #include "denoise/base/filters/nlmeans_filter.h"
 #include "denoise/base/input_planes.h"
+#include "denoise/base/nfor/selection_knee.h"
 #include "denoise/base/variance_estimates.h"
 
 namespace chorus {
@@ -36,6 +37,9 @@ NforParams NforParams::fromParams(ParamMap& map) {
   p.epsilon = map.getFloat("epsilon", p.epsilon);
   p.distanceClamp = map.getFloat("distanceClamp", p.distanceClamp);
   p.minCenterWeight = map.getFloat("minCenterWeight", p.minCenterWeight);
+  p.selectionKnee = map.getFloat("selectionKnee", p.selectionKnee);
+  if (!(p.selectionKnee >= 0) || !std::isfinite(p.selectionKnee))
+    throw Error("nfor: selectionKnee must be 0 (off) or positive");
   for (int v : {p.prefilterF, p.prefilterR, p.regressionF, p.regressionR, p.mseF, p.mseR,
                 p.finalFeatureF, p.finalFeatureR, p.finalF, p.finalR})
     if (v < 0 || v > 32) throw Error("nfor: patch and window radii must be in [0, 32]");
@@ -157,6 +161,9 @@ class NforRun {
                      const std::array<Image, 2>& y1, const std::array<Image, 2>& y2) const {
     Image mse[2];
     for (int i = 0; i < 2; ++i) mse[i] = mseEstimate(c1, c2, y1[i], y2[i], sigma2);
+    kneeBrightErrors(mse[0], mse[1], c,
+                     combine(y1[0], y2[0], [](float a, float b) { return (a + b) * 0.5f; }),
+                     p_.selectionKnee);
     const NlMeansWeights smoothing(perChannelTerm(c, sigma2, p_.mseF, p_.mseK, 1.0f),
                                    window(p_.mseR));
     const Image* mses[] = {&mse[0], &mse[1]};

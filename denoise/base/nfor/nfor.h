@@ -11,9 +11,11 @@
 //      smoothed the same way, blends the two bandwidths (§5.3);
 //   4. a second regression of the blended halves' mean on the re-filtered mean features (§5.4).
 // Features, in Tungsten's order: depth, albedo R G B, normal x y z, visibility.
-// Deviations from Tungsten (see README): a Gram-matrix solver with rank-revealing pivoting
-// instead of Eigen's column-pivoted QR on the window matrix (same fitted values for full-rank
-// windows), float sums in other orders; nothing else.
+// Deviations from Tungsten (docs/members/nfor-nlm.md): a Gram-matrix solver with rank-revealing
+// pivoting instead of Eigen's column-pivoted QR on the window matrix (same fitted values for
+// full-rank windows), float sums in other orders, the NL-means average where a regression
+// extrapolates far beyond its window's data, and very bright pixels' MSE scaled down before
+// the selection's smoothing (selectionKnee).
 #include "denoise/base/base_denoiser.h"
 #include "denoise/base/param_map.h"
 
@@ -38,6 +40,9 @@ struct NforParams {
   float finalK = 1.0f;
   // NL-means constants of Tungsten's nlMeansWeights.
   float epsilon = 1e-7f, distanceClamp = 1e4f, minCenterWeight = 1e-4f;
+  // Not Tungsten's: pixels brighter than this times the image's mean |colour| enter the MSE
+  // smoothing of step 3 scaled down to that level (relative error above it); 0 = Tungsten's.
+  float selectionKnee = 16.0f;
 
   // Reads overrides (keys = the field names above); unread keys stay in the map.
   static NforParams fromParams(ParamMap& map);

@@ -2,7 +2,7 @@
 // including 4 spp quarters (one sample each, so the variance falls back to the two-buffer
 // estimate), constant and black images, determinism, non-finite inputs, registry.
 #include "denoise/base/nfor/nfor.h"
-#include "denoise/base/nfor/selection_knee.h"
+#include "denoise/base/selection_knee.h"
 
 #include <gtest/gtest.h>
 

@@ -88,9 +88,10 @@ TEST(Sbf, NonFiniteInputsGiveFiniteOutputs) {
 }
 
 TEST(Sbf, RegistryAndParameters) {
-  test::expectCreates("sbf:sigmaS=0/2/4:sigmaMse=4:sigmaN=1", "sbf",
+  test::expectCreates("sbf:sigmaS=0/2/4:sigmaMse=4:sigmaN=1:selectionKnee=0", "sbf",
                       {.features = true, .halves = false});
-  test::expectRejected({"sbf:sigmaS=1/x", "sbf:sigmaS=", "sbf:sigmaMse=-1", "sbf:sigma=1"});
+  test::expectRejected(
+      {"sbf:sigmaS=1/x", "sbf:sigmaS=", "sbf:sigmaMse=-1", "sbf:sigma=1", "sbf:selectionKnee=-1"});
   // Only the identity candidate: the output is the input.
   test::expectIdentity("sbf:sigmaS=0");
 }

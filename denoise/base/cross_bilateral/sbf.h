@@ -7,8 +7,8 @@
 //   2. SURE of every candidate per pixel, from the colour's variance of the mean (sure.h);
 //   3. every SURE map smoothed by a feature-only cross-bilateral of width sigmaMse;
 //   4. per pixel the candidate with the smallest smoothed SURE (hard selection, no blending).
-// Deviation: no adaptive sampling (chorus renders a fixed budget), so only the final-image
-// settings are used.
+// Deviations: no adaptive sampling (chorus renders a fixed budget), so only the final-image
+// settings are used; bright pixels' SURE in relative units before step 3 (selectionKnee).
 #include <string>
 #include <vector>
 
@@ -27,8 +27,12 @@ struct SbfParams {
   // Spatial width of the SURE-map smoothing; 0 (default): sureSmoothingWidth of the buffer's
   // samples per pixel (the release uses 8 for the final image, 4 while sampling adaptively).
   float sigmaMse = 0.0f;
+  // Not the release's: pixels brighter than this times the image's mean |colour| enter step 3
+  // with their SURE in relative units (denoise/base/selection_knee.h); 0 = the release's.
+  float selectionKnee = 16.0f;
 
-  // Reads overrides: sigmaS=0/1/2/4/8 (slash-separated), sigmaN, sigmaR, sigmaD, sigmaMse.
+  // Reads overrides: sigmaS=0/1/2/4/8 (slash-separated), sigmaN, sigmaR, sigmaD, sigmaMse,
+  // selectionKnee.
   // Throws chorus::Error for a value out of range.
   static SbfParams fromParams(ParamMap& params);
 };

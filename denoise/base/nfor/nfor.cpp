@@ -11,7 +11,7 @@
 #include "denoise/base/filters/local_range.h"
 #include "denoise/base/filters/nlmeans_filter.h"
 #include "denoise/base/input_planes.h"
-#include "denoise/base/nfor/selection_knee.h"
+#include "denoise/base/selection_knee.h"
 #include "denoise/base/variance_estimates.h"
 
 namespace chorus {

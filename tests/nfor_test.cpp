@@ -108,17 +108,24 @@ TEST(Nfor, SelectionKneePutsBrightPixelsOnTheRelativeScale) {
       mse1(x, 0, 0) = float(e1[x] * s * s);
     }
   };
+  // As NFOR applies it: the maps per pixel and channel, the level's own values.
+  const auto kneeErrors = [&](float knee) {
+    float* const maps[] = {mse0.data(), mse1.data()};
+    kneeBrightErrors(
+        maps, level.size(), [&](size_t e) { return double(level.data()[e]); },
+        kneeLevel({colour.data(), colour.size()}, knee));
+  };
   const float expected0[4] = {3.0f, 2.0f, 10.0f, 5.0f}, expected1[4] = {-1.0f, 3.0f, 1.0f, 7.0f};
   for (double s : {1.0, 1e-15, 1e15}) {
     fill(s);
-    kneeBrightErrors(mse0, mse1, colour, level, 16.0f);
+    kneeErrors(16.0f);
     for (int x = 0; x < 4; ++x) {
       EXPECT_NEAR(mse0(x, 0, 0) / (s * s), expected0[x], 1e-5 * std::abs(expected0[x])) << x;
       EXPECT_NEAR(mse1(x, 0, 0) / (s * s), expected1[x], 1e-5 * std::abs(expected1[x])) << x;
     }
   }
   fill(1.0);
-  kneeBrightErrors(mse0, mse1, colour, level, 0.0f);
+  kneeErrors(0.0f);
   for (int x = 0; x < 4; ++x) EXPECT_EQ(mse0(x, 0, 0), e0[x]);
 }
 

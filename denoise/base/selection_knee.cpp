@@ -19,16 +19,4 @@ double kneeDivisor(double level, double kneeLevel) {
   return r * r > 1.0 ? r * r : 1.0;  // below the knee, or not finite: 1
 }
 
-void kneeBrightErrors(Image& mse0, Image& mse1, const Image& colour, const Image& level,
-                      float knee) {
-  const double unit = kneeLevel({colour.data(), colour.size()}, knee);
-  if (!(unit > 0)) return;
-  for (size_t e = 0; e < level.size(); ++e) {
-    const double d = kneeDivisor(double(level.data()[e]), unit);
-    if (d == 1.0) continue;
-    mse0.data()[e] = float(double(mse0.data()[e]) / d);
-    mse1.data()[e] = float(double(mse1.data()[e]) / d);
-  }
-}
-
 }  // namespace chorus

@@ -8,9 +8,9 @@
 // spread the highlight; docs/members/nfor-nlm.md). Above `knee` times the image's mean |colour|
 // a pixel's errors are divided by (level / that)²: relative error above the knee, absolute (the
 // published methods') below it. Invariant to the unit of radiance.
+#include <cstddef>
+#include <limits>
 #include <span>
-
-#include "common/image/image.h"
 
 namespace chorus {
 
@@ -20,9 +20,18 @@ double kneeLevel(std::span<const float> colour, float knee);
 // What a pixel at `level` divides its errors by: (level / kneeLevel)² above the knee, else 1.
 double kneeDivisor(double level, double kneeLevel);
 
-// NFOR: mse0, mse1 are the two bandwidths' MSE maps, `level` per pixel and channel the pixel's
-// own level (the mean of the halves' narrow-bandwidth outputs); all the shape of `colour`.
-void kneeBrightErrors(Image& mse0, Image& mse1, const Image& colour, const Image& level,
-                      float knee);
+// Every error map's element e divided by kneeDivisor(level(e), kneeLevel), for e < count; an
+// element at FLT_MAX (a member's mark for "unusable") stays. NFOR: its two bandwidths' MSE maps,
+// e per pixel and channel; SBF: its candidates' SURE planes, e per pixel.
+template <typename Level>
+void kneeBrightErrors(std::span<float* const> maps, size_t count, Level&& level, double kneeLevel) {
+  if (!(kneeLevel > 0)) return;
+  for (size_t e = 0; e < count; ++e) {
+    const double d = kneeDivisor(level(e), kneeLevel);
+    if (d == 1.0) continue;
+    for (float* map : maps)
+      if (map[e] < std::numeric_limits<float>::max()) map[e] = float(double(map[e]) / d);
+  }
+}
 
 }  // namespace chorus

@@ -58,8 +58,7 @@ SbfParams SbfParams::fromParams(ParamMap& params) {
   p.sigmaD = params.getFloat("sigmaD", p.sigmaD);
   p.sigmaMse = params.getFloat("sigmaMse", p.sigmaMse);
   p.selectionKnee = params.getFloat("selectionKnee", p.selectionKnee);
-  if (!(p.selectionKnee >= 0) || !std::isfinite(p.selectionKnee))
-    throw Error("sbf: selectionKnee must be 0 (off) or positive");
+  requirePositive(p.selectionKnee, "selectionKnee");
   requirePositive(p.sigmaN, "sigmaN");
   requirePositive(p.sigmaR, "sigmaR");
   requirePositive(p.sigmaD, "sigmaD");
@@ -105,20 +104,17 @@ SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params) {
   // 3. Smooth the SURE maps (the raw per-pixel estimates are far too noisy to select with),
   // a bright pixel's in relative units (selection_knee.h: the features cannot tell a highlight
   // seen in a mirror from the surface around it); its level: the first candidate's output.
-  const double knee = kneeLevel({color.plane(0), size_t(3) * pixels}, params.selectionKnee);
-  if (knee > 0)
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                        for (size_t i = r.begin(); i < r.end(); ++i) {
-                          double level = 0;
-                          for (int c = 0; c < 3; ++c) level += candidates[0].filtered.plane(c)[i];
-                          const double d = kneeDivisor(level / 3.0, knee);
-                          if (d == 1.0) continue;
-                          for (int s = 0; s < candidateCount; ++s)
-                            if (sure.plane(s)[i] < std::numeric_limits<float>::max())
-                              sure.plane(s)[i] = float(double(sure.plane(s)[i]) / d);
-                        }
-                      });
+  std::vector<float*> maps;
+  for (int s = 0; s < candidateCount; ++s) maps.push_back(sure.plane(s));
+  const BilateralCandidate& first = candidates[0];
+  kneeBrightErrors(
+      maps, pixels,
+      [&](size_t i) {
+        double level = 0;
+        for (int c = 0; c < 3; ++c) level += first.filtered.plane(c)[i];
+        return level / 3.0;
+      },
+      kneeLevel({color.plane(0), size_t(3) * pixels}, params.selectionKnee));
   const float sigmaMse =
       params.sigmaMse > 0 ? params.sigmaMse : sureSmoothingWidth(meanSampleCount(buffer));
   const PlanarImage smoothed = crossBilateralSmooth(sure, guide, sigmaMse);

@@ -114,6 +114,11 @@ Image combine(const Image& a, const Image& b, Fn&& fn) {
   return out;
 }
 
+// Per-pixel mean of two images of the same shape.
+Image pixelMean(const Image& a, const Image& b) {
+  return combine(a, b, [](float x, float y) { return (x + y) * 0.5f; });
+}
+
 class NforRun {
  public:
   NforRun(const NforParams& p, const DenoiseInput& input) : p_(p), input_(input) {}
@@ -161,9 +166,12 @@ class NforRun {
                      const std::array<Image, 2>& y1, const std::array<Image, 2>& y2) const {
     Image mse[2];
     for (int i = 0; i < 2; ++i) mse[i] = mseEstimate(c1, c2, y1[i], y2[i], sigma2);
-    kneeBrightErrors(mse[0], mse[1], c,
-                     combine(y1[0], y2[0], [](float a, float b) { return (a + b) * 0.5f; }),
-                     p_.selectionKnee);
+    // The pixel's level: the halves' narrow-bandwidth outputs (selection_knee.h).
+    const Image level = pixelMean(y1[0], y2[0]);
+    float* const maps[] = {mse[0].data(), mse[1].data()};
+    kneeBrightErrors(
+        maps, level.size(), [&](size_t e) { return double(level.data()[e]); },
+        kneeLevel({c.data(), c.size()}, p_.selectionKnee));
     const NlMeansWeights smoothing(perChannelTerm(c, sigma2, p_.mseF, p_.mseK, 1.0f),
                                    window(p_.mseR));
     const Image* mses[] = {&mse[0], &mse[1]};
@@ -176,15 +184,14 @@ class NforRun {
   // Second filter pass (§5.4) on the means of the halves, with their dual-buffer variances.
   Image secondPass(const std::array<Image, 2>& fFiltered, const std::array<Image, 2>& r) const {
     const Image fFinal = finalFeatures(fFiltered);
-    const Image rMean = combine(r[0], r[1], [](float a, float b) { return (a + b) * 0.5f; });
+    const Image rMean = pixelMean(r[0], r[1]);
     const Image rMeanVar =
         combine(r[0], r[1], [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
     return regress(rMean, fFinal, rMean, rMeanVar, p_.finalF, p_.finalK, p_.finalR);
   }
 
   Image finalFeatures(const std::array<Image, 2>& fFiltered) const {
-    const Image fMean =
-        combine(fFiltered[0], fFiltered[1], [](float a, float b) { return (a + b) * 0.5f; });
+    const Image fMean = pixelMean(fFiltered[0], fFiltered[1]);
     const Image fMeanVar = combine(fFiltered[0], fFiltered[1],
                                    [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
     return nlMeans(fMean, perChannelTerm(fMean, fMeanVar, p_.finalFeatureF, p_.finalFeatureK, 1.0f),

@@ -95,9 +95,11 @@ TEST(Rdfc, NeedsHalves) {
 }
 
 TEST(Rdfc, RegistryAndParameters) {
-  const auto rdfc = test::expectCreates("rdfc:r=6:kc=0.5:kf=0.7:tau=0.002:rescale=false", "rdfc",
-                                        {.features = true, .halves = true});
-  test::expectRejected({"rdfc:r=0", "rdfc:kc=-1", "rdfc:tau=nan", "rdfc:k=1"});
+  const auto rdfc =
+      test::expectCreates("rdfc:r=6:kc=0.5:kf=0.7:tau=0.002:rescale=false:selectionKnee=0", "rdfc",
+                          {.features = true, .halves = true});
+  test::expectRejected({"rdfc:r=0", "rdfc:kc=-1", "rdfc:tau=nan", "rdfc:k=1",
+                        "rdfc:selectionKnee=-1", "rdfc:selectionKnee=inf"});
   test::expectReducesRelMse(*rdfc, 4);
 }
 

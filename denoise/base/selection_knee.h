@@ -1,13 +1,14 @@
 #pragma once
 // A knee for members that choose per pixel among candidates by a smoothed error estimate (NFOR's
-// two bandwidths, SBF's filter widths). Not in the published methods: the smoothing reaches a
-// dark pixel's neighbours through weights that a few bright, noisy pixels barely move (NFOR's
-// patch distances; SBF's features, which do not show a highlight in a mirror), and their errors,
-// in absolute units, are thousands of times the dark pixel's own, so they choose its candidate
-// (a softbox seen in chrome at 4 spp: the wide candidates were chosen around it, where they
-// spread the highlight; docs/members/nfor-nlm.md). Above `knee` times the image's mean |colour|
-// a pixel's errors are divided by (level / that)²: relative error above the knee, absolute (the
-// published methods') below it. Invariant to the unit of radiance.
+// two bandwidths, SBF's filter widths, RDFC's three candidates). Not in the published methods:
+// the smoothing reaches a dark pixel's neighbours through weights that a few bright, noisy pixels
+// barely move (NFOR's patch distances; SBF's features, which do not show a highlight in a mirror;
+// RDFC's colour patches at a light's edge at few samples), and their errors, in absolute units,
+// are thousands of times the dark pixel's own, so they choose its candidate (a softbox seen in
+// chrome at 4 spp: the wide candidates were chosen around it, where they spread the highlight;
+// docs/members/nfor-nlm.md). Above `knee` times the image's mean |colour| a pixel's errors are
+// divided by (level / that)²: relative error above the knee, absolute (the published methods')
+// below it. Invariant to the unit of radiance.
 #include <cstddef>
 #include <limits>
 #include <span>
@@ -22,7 +23,7 @@ double kneeDivisor(double level, double kneeLevel);
 
 // Every error map's element e divided by kneeDivisor(level(e), kneeLevel), for e < count; an
 // element at FLT_MAX (a member's mark for "unusable") stays. NFOR: its two bandwidths' MSE maps,
-// e per pixel and channel; SBF: its candidates' SURE planes, e per pixel.
+// e per pixel and channel; SBF and RDFC: their candidates' SURE planes, e per pixel.
 template <typename Level>
 void kneeBrightErrors(std::span<float* const> maps, size_t count, Level&& level, double kneeLevel) {
   if (!(kneeLevel > 0)) return;

@@ -7,6 +7,7 @@
 #include "common/error.h"
 #include "denoise/base/buffer_variance.h"
 #include "denoise/base/filters/feature_nlmeans.h"
+#include "denoise/base/selection_knee.h"
 #include "denoise/util/parallel_rows.h"
 
 namespace chorus {
@@ -28,10 +29,23 @@ std::vector<Image> colorNlMeans(std::span<const Image* const> data, const Image&
   return featureNlMeans(data, &patch, {}, {.r = r, .minCenterWeight = kRdfcMinCenterWeight});
 }
 
-// Step 4: smoothed SURE maps, argmin with RDFC's rules, smoothed binary maps.
+// Step 4: smoothed SURE maps, argmin with RDFC's rules, smoothed binary maps. Before the
+// smoothing a bright pixel's SURE goes to the relative scale (selection_knee.h): the colour
+// patches of a light's edge at few samples are so noisy that the light's pixels enter a dark
+// neighbour's sum, where their errors in absolute units chose THIRD, which spreads the light.
 void selectCandidates(const Image& guide, const Image& variance, const RdfcParams& params,
                       RdfcResult& result) {
   const int w = guide.width(), h = guide.height();
+  float* const sureMaps[] = {result.candidates[0].sure.data(), result.candidates[1].sure.data(),
+                             result.candidates[2].sure.data()};
+  const Image& narrowest = result.candidates[0].mean;
+  kneeBrightErrors(
+      sureMaps, size_t(w) * size_t(h),
+      [&](size_t i) {
+        const float* rgb = narrowest.data() + 3 * i;
+        return (double(rgb[0]) + rgb[1] + rgb[2]) / 3.0;
+      },
+      kneeLevel({guide.data(), guide.size()}, params.selectionKnee));
   const Image* sure[] = {&result.candidates[0].sure, &result.candidates[1].sure,
                          &result.candidates[2].sure};
   std::vector<Image> smoothed = colorNlMeans(sure, guide, variance, params, params.sureR);
@@ -130,6 +144,7 @@ RdfcParams RdfcParams::fromParams(ParamMap& map) {
   p.prefilter.rescaleVariance = p.rescaleVariance;
   p.sureR = map.getInt("sureR", p.sureR);
   p.selectionR = map.getInt("selectionR", p.selectionR);
+  p.selectionKnee = map.getFloat("selectionKnee", p.selectionKnee);
   p.secondR = map.getInt("secondR", p.secondR);
   p.secondF = map.getInt("secondF", p.secondF);
   p.secondKc = map.getFloat("secondKc", p.secondKc);
@@ -148,6 +163,8 @@ RdfcParams RdfcParams::fromParams(ParamMap& map) {
                    std::isfinite(c.tauThird) && c.tauThird >= 0 && std::isfinite(p.secondTau) &&
                    p.secondTau >= 0,
                "tau, tauThird, secondTau must be ≥ 0");
+  requireRange(std::isfinite(p.selectionKnee) && p.selectionKnee >= 0,
+               "selectionKnee must be 0 (off) or positive");
   return p;
 }
 

@@ -40,6 +40,9 @@ struct RdfcParams {
   int selectionF = 3;       // patch radius
   float selectionK = 1.0f;  // k
   int selectionBoxRadius = 2;
+  // Bright pixels' SURE in relative units before its smoothing (selection_knee.h): above
+  // selectionKnee × the image's mean |colour|, FIRST's output as the level. 0: the release's.
+  float selectionKnee = 4.0f;
   // Second pass.
   int secondR = 5;
   int secondF = 3;
@@ -49,8 +52,8 @@ struct RdfcParams {
   int secondBoxRadius = 2;
 
   // Overrides (CLI names): r, kc, kf, fFirst, fSecond, tau, tauThird, rescale, sureR,
-  // selectionR, secondR, secondF, secondKc, secondKf, secondTau. Throws chorus::Error for a
-  // value out of range.
+  // selectionR, selectionKnee, secondR, secondF, secondKc, secondKf, secondTau. Throws
+  // chorus::Error for a value out of range.
   static RdfcParams fromParams(ParamMap& params);
 };
 

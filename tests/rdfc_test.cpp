@@ -90,16 +90,45 @@ TEST(Rdfc, NonFiniteInputsGiveFiniteOutputs) {
   });
 }
 
+// The second pass's variance on numbers worked by hand: one row of three pixels, levels 1, 8, 3
+// (mean 4), (b1 − b2)²/4 = 1, 400, 4. Knee 1: the middle pixel (level 8 = 2 × 4) is smoothed as
+// 400 / 4 = 100 and multiplied back by 4; knee 0: as is. Taps [w, 1, w] / (taps used), w = e^−2,
+// only horizontal in one row. Scaling colour by s scales the variance by s².
+TEST(Rdfc, SecondPassVarianceSmoothsBrightPixelsInRelativeUnits) {
+  const float level[3] = {1.0f, 8.0f, 3.0f}, halfDifference[3] = {1.0f, 20.0f, 2.0f};
+  const double w = std::exp(-2.0);
+  const double kneed[3] = {(1 + 100 * w) / (1 + w), 4 * (w + 100 + 4 * w) / (1 + 2 * w),
+                           (100 * w + 4) / (1 + w)};
+  const double plain[3] = {(1 + 400 * w) / (1 + w), (w + 400 + 4 * w) / (1 + 2 * w),
+                           (400 * w + 4) / (1 + w)};
+  for (double s : {1.0, 1e-10, 1e10}) {
+    Image first1(3, 1, 3), first2(3, 1, 3), guide(3, 1, 3);
+    for (int x = 0; x < 3; ++x)
+      for (int c = 0; c < 3; ++c) {
+        guide(x, 0, c) = float(level[x] * s);
+        first1(x, 0, c) = float((level[x] + halfDifference[x]) * s);
+        first2(x, 0, c) = float((level[x] - halfDifference[x]) * s);
+      }
+    const Image withKnee = rdfcSecondPassVariance(first1, first2, guide, 1.0f);
+    const Image without = rdfcSecondPassVariance(first1, first2, guide, 0.0f);
+    for (int x = 0; x < 3; ++x)
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(withKnee(x, 0, c) / (s * s), kneed[x], 1e-5 * kneed[x]) << x << " " << s;
+        EXPECT_NEAR(without(x, 0, c) / (s * s), plain[x], 1e-5 * plain[x]) << x << " " << s;
+      }
+  }
+}
+
 TEST(Rdfc, NeedsHalves) {
   test::expectNeedsHalves(Rdfc());
 }
 
 TEST(Rdfc, RegistryAndParameters) {
-  const auto rdfc =
-      test::expectCreates("rdfc:r=6:kc=0.5:kf=0.7:tau=0.002:rescale=false:selectionKnee=0", "rdfc",
-                          {.features = true, .halves = true});
+  const auto rdfc = test::expectCreates(
+      "rdfc:r=6:kc=0.5:kf=0.7:tau=0.002:rescale=false:selectionKnee=0:varianceKnee=0", "rdfc",
+      {.features = true, .halves = true});
   test::expectRejected({"rdfc:r=0", "rdfc:kc=-1", "rdfc:tau=nan", "rdfc:k=1",
-                        "rdfc:selectionKnee=-1", "rdfc:selectionKnee=inf"});
+                        "rdfc:selectionKnee=-1", "rdfc:selectionKnee=inf", "rdfc:varianceKnee=-1"});
   test::expectReducesRelMse(*rdfc, 4);
 }
 

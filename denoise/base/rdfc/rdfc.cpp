@@ -104,7 +104,7 @@ Image blendCandidates(const RdfcResult& result, Image RdfcCandidate::*buffer) {
 Image secondPass(const Image& first1, const Image& first2, const std::vector<RdfcFeature>& features,
                  const RdfcParams& params) {
   const Image guide = meanOf(first1, first2);
-  const Image variance = smooth3Tap(squaredDifference(first1, first2, 0.25f), std::exp(-2.0f));
+  const Image variance = rdfcSecondPassVariance(first1, first2, guide, params.varianceKnee);
   const PatchTerm patch{.guide = &guide,
                         .variance = &variance,
                         .f = params.secondF,
@@ -130,6 +130,25 @@ Image secondPass(const Image& first1, const Image& first2, const std::vector<Rdf
 
 }  // namespace
 
+// Smoothed as is (knee 0), a highlight's variance at few samples became its
+// dark neighbours' (10⁴ times their own), which made every patch distance to the highlight
+// small, and the second pass spread it into them (a softbox seen in chrome at 4 spp).
+Image rdfcSecondPassVariance(const Image& first1, const Image& first2, const Image& guide,
+                             float knee) {
+  Image raw = squaredDifference(first1, first2, 0.25f);
+  const double level = kneeLevel({guide.data(), guide.size()}, knee);
+  std::vector<float> divisor(guide.pixelCount(), 1.0f);
+  for (size_t i = 0; i < divisor.size(); ++i) {
+    const float* rgb = guide.data() + 3 * i;
+    divisor[i] = float(kneeDivisor(std::abs((double(rgb[0]) + rgb[1] + rgb[2]) / 3.0), level));
+    for (int c = 0; c < 3; ++c) raw.data()[3 * i + size_t(c)] /= divisor[i];
+  }
+  Image variance = smooth3Tap(raw, std::exp(-2.0f));
+  for (size_t i = 0; i < divisor.size(); ++i)
+    for (int c = 0; c < 3; ++c) variance.data()[3 * i + size_t(c)] *= divisor[i];
+  return variance;
+}
+
 RdfcParams RdfcParams::fromParams(ParamMap& map) {
   RdfcParams p;
   RdfcCandidateParams& c = p.candidates;
@@ -145,6 +164,7 @@ RdfcParams RdfcParams::fromParams(ParamMap& map) {
   p.sureR = map.getInt("sureR", p.sureR);
   p.selectionR = map.getInt("selectionR", p.selectionR);
   p.selectionKnee = map.getFloat("selectionKnee", p.selectionKnee);
+  p.varianceKnee = map.getFloat("varianceKnee", p.varianceKnee);
   p.secondR = map.getInt("secondR", p.secondR);
   p.secondF = map.getInt("secondF", p.secondF);
   p.secondKc = map.getFloat("secondKc", p.secondKc);
@@ -163,8 +183,9 @@ RdfcParams RdfcParams::fromParams(ParamMap& map) {
                    std::isfinite(c.tauThird) && c.tauThird >= 0 && std::isfinite(p.secondTau) &&
                    p.secondTau >= 0,
                "tau, tauThird, secondTau must be ≥ 0");
-  requireRange(std::isfinite(p.selectionKnee) && p.selectionKnee >= 0,
-               "selectionKnee must be 0 (off) or positive");
+  requireRange(std::isfinite(p.selectionKnee) && p.selectionKnee >= 0 &&
+                   std::isfinite(p.varianceKnee) && p.varianceKnee >= 0,
+               "selectionKnee and varianceKnee must be 0 (off) or positive");
   return p;
 }
 

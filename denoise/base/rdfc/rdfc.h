@@ -50,10 +50,13 @@ struct RdfcParams {
   float secondKf = 0.6f;
   float secondTau = 1e-4f;
   int secondBoxRadius = 2;
+  // Bright pixels' variance smoothed in relative units above varianceKnee × the image's mean
+  // |colour| (the first pass's output as the level). 0: the release's smoothing.
+  float varianceKnee = 4.0f;
 
   // Overrides (CLI names): r, kc, kf, fFirst, fSecond, tau, tauThird, rescale, sureR,
-  // selectionR, selectionKnee, secondR, secondF, secondKc, secondKf, secondTau. Throws
-  // chorus::Error for a value out of range.
+  // selectionR, selectionKnee, varianceKnee, secondR, secondF, secondKc, secondKf, secondTau.
+  // Throws chorus::Error for a value out of range.
   static RdfcParams fromParams(ParamMap& params);
 };
 
@@ -69,6 +72,13 @@ struct RdfcResult {
 
 // Runs RDFC; the input must have halves (throws chorus::Error otherwise). Every output finite.
 RdfcResult runRdfc(const DenoiseInput& input, const RdfcParams& params);
+
+// The second pass's colour variance: the first-pass buffers' (b1 − b2)²/4 smoothed by
+// smooth3Tap (w = e^−2), where a pixel whose |level| (the mean over RGB of `guide`, b1 and b2's
+// mean) exceeds knee × the image's mean |colour| has its value divided by (level / that)² before
+// the smoothing and multiplied back after: relative units for bright pixels (selection_knee.h).
+Image rdfcSecondPassVariance(const Image& first1, const Image& first2, const Image& guide,
+                             float knee);
 
 class Rdfc : public BaseDenoiser {
  public:

@@ -5,10 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 
 #include "denoise/metrics/metrics.h"
 #include "tests/support/denoiser_checks.h"
+#include "tests/support/gaussian_buffers.h"
 #include "tests/support/synthetic_scene.h"
 
 namespace chorus {
@@ -17,6 +20,48 @@ namespace {
 // Documented in docs/members/rdfc-jnlm.md (joint NL-means): measured relMSE 0.053 → 0.0049 (11×) at
 // 64×64, 16 spp, cross-filtered halves.
 constexpr double kMinImprovement = 6.0;
+
+// A small highlight (2 × 3 pixels at 10⁴ times the wall, half its value as noise) on a wall whose
+// features do not show it, cross-filtered: each half's weights come from the other half, in which
+// the highlight's noise made its patches look like the wall's, and the highlight was averaged
+// into the wall around it (10⁴–10⁵ times the noisy error there without the variance knee). With
+// the knee the wall around it must be no worse than its noisy input, while the wall away from
+// it is still denoised.
+TEST(JointNlMeans, KeepsASmallHighlightOffTheWallAroundIt) {
+  const int w = 64, h = 64;
+  const auto inHighlight = [](int x, int y) { return x >= 19 && x <= 21 && y >= 11 && y <= 12; };
+  Image truth(w, h, 3), sigma(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        truth(x, y, c) = inHighlight(x, y) ? 1000.0f : 0.1f;
+        sigma(x, y, c) = inHighlight(x, y) ? 500.0f : 0.05f;
+      }
+  SubBuffer features = SubBuffer::zeros(w, h);
+  for (float& v : features.albedo.mean.values()) v = 0.5f;
+  for (int i = 0; i < w * h; ++i) features.normal.mean.data()[i * 3 + 2] = 1.0f;
+  for (float& v : features.depth.mean.values()) v = 2.0f;
+  for (float& v : features.visibility.mean.values()) v = 1.0f;
+  for (float& v : features.sampleCount.values()) v = 8.0f;
+  for (uint32_t seed = 1; seed <= 3; ++seed) {
+    const DenoiseInput input = test::gaussianHalves(truth, sigma, features, seed);
+    const Image out = runJointNlMeans(input, JointNlMeansParams{});
+    // Squared error over the wall within 2 pixels of the highlight (near) and beyond 8 (far).
+    auto wallError = [&](const Image& image, bool near) {
+      double e = 0;
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const int d = std::max({19 - x, x - 21, 11 - y, y - 12, 0});
+          if (inHighlight(x, y) || (near ? d > 2 : d <= 8)) continue;
+          for (int c = 0; c < 3; ++c) e += std::pow(image(x, y, c) - truth(x, y, c), 2.0);
+        }
+      return e;
+    };
+    const Image& noisy = input.whole.color.mean;
+    EXPECT_LE(wallError(out, true), 1.05 * wallError(noisy, true)) << seed;
+    EXPECT_LT(wallError(out, false), 0.5 * wallError(noisy, false)) << seed;
+  }
+}
 
 TEST(JointNlMeans, ReducesRelMseOnTheSyntheticScene) {
   test::expectReducesRelMse(JointNlMeans(), kMinImprovement);
@@ -83,9 +128,11 @@ TEST(JointNlMeans, NonFiniteInputsGiveFiniteOutputs) {
 }
 
 TEST(JointNlMeans, RegistryAndParameters) {
-  const auto jnlm = test::expectCreates("jnlm:r=3:f=1:k=0.5:kf=0.7:tau=0.002:refineFeatures=true",
-                                        "jnlm", {.features = true, .halves = false});
-  test::expectRejected({"jnlm:r=0", "jnlm:f=-1", "jnlm:k=0", "jnlm:window=3"});
+  const auto jnlm =
+      test::expectCreates("jnlm:r=3:f=1:k=0.5:kf=0.7:tau=0.002:refineFeatures=true:varianceKnee=0",
+                          "jnlm", {.features = true, .halves = false});
+  test::expectRejected(
+      {"jnlm:r=0", "jnlm:f=-1", "jnlm:k=0", "jnlm:window=3", "jnlm:varianceKnee=-1"});
   test::expectReducesRelMse(*jnlm, 4);
 }
 

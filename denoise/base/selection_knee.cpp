@@ -19,4 +19,14 @@ double kneeDivisor(double level, double kneeLevel) {
   return r * r > 1.0 ? r * r : 1.0;  // below the knee, or not finite: 1
 }
 
+std::vector<float> kneeDivisors(const Image& rgb, double kneeLevel) {
+  std::vector<float> divisors(rgb.pixelCount(), 1.0f);
+  if (!(kneeLevel > 0)) return divisors;
+  for (size_t i = 0; i < divisors.size(); ++i) {
+    const float* p = rgb.data() + 3 * i;
+    divisors[i] = float(kneeDivisor((double(p[0]) + p[1] + p[2]) / 3.0, kneeLevel));
+  }
+  return divisors;
+}
+
 }  // namespace chorus

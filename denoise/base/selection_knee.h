@@ -12,6 +12,9 @@
 #include <cstddef>
 #include <limits>
 #include <span>
+#include <vector>
+
+#include "common/image/image.h"
 
 namespace chorus {
 
@@ -20,6 +23,8 @@ namespace chorus {
 double kneeLevel(std::span<const float> colour, float knee);
 // What a pixel at `level` divides its errors by: (level / kneeLevel)² above the knee, else 1.
 double kneeDivisor(double level, double kneeLevel);
+// kneeDivisor of every pixel of an RGB image whose level is the mean of its three channels.
+std::vector<float> kneeDivisors(const Image& rgb, double kneeLevel);
 
 // Every error map's element e divided by kneeDivisor(level(e), kneeLevel), for e < count; an
 // element at FLT_MAX (a member's mark for "unusable") stays. NFOR: its two bandwidths' MSE maps,

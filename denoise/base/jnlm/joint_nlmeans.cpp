@@ -7,6 +7,7 @@
 #include "common/error.h"
 #include "denoise/base/buffer_variance.h"
 #include "denoise/base/filters/feature_nlmeans.h"
+#include "denoise/base/selection_knee.h"
 #include "denoise/base/variance_estimates.h"
 
 namespace chorus {
@@ -53,6 +54,16 @@ float largestFiniteValue(const Image& image) {
   return largest > 0.0f ? largest : 1.0f;
 }
 
+// The colour variance the patch distances divide by, a bright pixel's (its guide's level above
+// the knee) divided by (level / knee)²: its noise no longer excuses its difference from a dark
+// neighbour. Cross-filtered at few samples, a highlight's pixels looked like the dark pixels beside
+// them to the other half's weights, which then averaged this half's highlight into them.
+Image kneedVariance(Image variance, const Image& guide, double kneeLevel) {
+  const std::vector<float> divisor = kneeDivisors(guide, kneeLevel);
+  for (size_t k = 0; k < variance.size(); ++k) variance.data()[k] /= divisor[k / 3];
+  return variance;
+}
+
 void require(bool ok, const std::string& what) {
   if (!ok) throw Error("jnlm: " + what);
 }
@@ -68,11 +79,14 @@ JointNlMeansParams JointNlMeansParams::fromParams(ParamMap& map) {
   p.kf = map.getFloat("kf", p.kf);
   p.tau = map.getFloat("tau", p.tau);
   p.refineFeatures = map.getBool("refineFeatures", p.refineFeatures);
+  p.varianceKnee = map.getFloat("varianceKnee", p.varianceKnee);
   require(p.r >= 1 && p.r <= 32, "r must be in [1, 32]");
   require(p.f >= 0 && p.f <= 16, "f must be in [0, 16]");
   require(std::isfinite(p.k) && p.k > 0 && std::isfinite(p.kf) && p.kf > 0, "k and kf must be > 0");
   require(std::isfinite(p.alpha) && p.alpha >= 0, "alpha must be ≥ 0");
   require(std::isfinite(p.tau) && p.tau >= 0, "tau must be ≥ 0");
+  require(std::isfinite(p.varianceKnee) && p.varianceKnee >= 0,
+          "varianceKnee must be 0 (off) or positive");
   return p;
 }
 
@@ -99,21 +113,24 @@ Image runJointNlMeans(const DenoiseInput& input, const JointNlMeansParams& param
     return std::move(featureNlMeans(images, &patch, features, window)[0]);
   };
 
+  const double knee =
+      kneeLevel({whole.color.mean.data(), whole.color.mean.size()}, params.varianceKnee);
   Image out;
   if (input.halves) {
     const Image a = finiteOr((*input.halves)[0].color.mean, 0.0f);
     const Image b = finiteOr((*input.halves)[1].color.mean, 0.0f);
     // Each half's own variance of the mean, the smoothed two-buffer estimate where a half holds
     // a single sample.
-    const Image varianceA = halfVarianceOfMean(input, 0, Quantity::Color);
-    const Image varianceB = halfVarianceOfMean(input, 1, Quantity::Color);
+    const Image varianceA = kneedVariance(halfVarianceOfMean(input, 0, Quantity::Color), a, knee);
+    const Image varianceB = kneedVariance(halfVarianceOfMean(input, 1, Quantity::Color), b, knee);
     const Image filteredA = filter(a, b, varianceB);  // A's data, B's colour weights
     const Image filteredB = filter(b, a, varianceA);
     out = meanOf(filteredA, filteredB);
   } else {
     const Image color = finiteOr(whole.color.mean, 0.0f);
-    const Image variance =
-        completedVariance(whole.color.varianceOfMean, Image(color.width(), color.height(), 3));
+    const Image variance = kneedVariance(
+        completedVariance(whole.color.varianceOfMean, Image(color.width(), color.height(), 3)),
+        color, knee);
     out = filter(color, color, variance);
   }
   const Image noisy = finiteOr(whole.color.mean, 0.0f);

@@ -29,9 +29,12 @@ struct JointNlMeansParams {
   float kf = 0.6f;     // feature sensitivity (RDFC's k_f)
   float tau = 1e-3f;  // feature variance floor (depth: τ · maxDepth²), RDFC's FIRST/SECOND value
   bool refineFeatures = false;  // symmetric refinement of the feature terms (RDFC: on)
+  // The colour variance of a pixel whose level exceeds varianceKnee × the image's mean |colour|
+  // divided by (level / that)² in the patch distances (selection_knee.h). 0: Rousselle's.
+  float varianceKnee = 64.0f;
 
-  // Overrides: r, f, k, alpha, kf, tau, refineFeatures. Throws chorus::Error for a value out of
-  // range.
+  // Overrides: r, f, k, alpha, kf, tau, refineFeatures, varianceKnee. Throws chorus::Error for a
+  // value out of range.
   static JointNlMeansParams fromParams(ParamMap& params);
 };
 

@@ -136,16 +136,11 @@ Image secondPass(const Image& first1, const Image& first2, const std::vector<Rdf
 Image rdfcSecondPassVariance(const Image& first1, const Image& first2, const Image& guide,
                              float knee) {
   Image raw = squaredDifference(first1, first2, 0.25f);
-  const double level = kneeLevel({guide.data(), guide.size()}, knee);
-  std::vector<float> divisor(guide.pixelCount(), 1.0f);
-  for (size_t i = 0; i < divisor.size(); ++i) {
-    const float* rgb = guide.data() + 3 * i;
-    divisor[i] = float(kneeDivisor(std::abs((double(rgb[0]) + rgb[1] + rgb[2]) / 3.0), level));
-    for (int c = 0; c < 3; ++c) raw.data()[3 * i + size_t(c)] /= divisor[i];
-  }
+  const std::vector<float> divisor =
+      kneeDivisors(guide, kneeLevel({guide.data(), guide.size()}, knee));
+  for (size_t k = 0; k < raw.size(); ++k) raw.data()[k] /= divisor[k / 3];
   Image variance = smooth3Tap(raw, std::exp(-2.0f));
-  for (size_t i = 0; i < divisor.size(); ++i)
-    for (int c = 0; c < 3; ++c) variance.data()[3 * i + size_t(c)] *= divisor[i];
+  for (size_t k = 0; k < variance.size(); ++k) variance.data()[k] *= divisor[k / 3];
   return variance;
 }
 

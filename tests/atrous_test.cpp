@@ -5,12 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <tuple>
 
 #include "denoise/metrics/metrics.h"
 #include "tests/support/denoiser_checks.h"
+#include "tests/support/gaussian_buffers.h"
 #include "tests/support/synthetic_scene.h"
 #include "tests/support/test_support.h"
 
@@ -265,6 +267,47 @@ TEST(Atrous, BorrowKeepsADarkLineBesideALitPatchDark) {
   EXPECT_TRUE(test::bitIdentical(Atrous(symmetric).run(input), Atrous(symmetricSvgf).run(input)));
 }
 
+// A small highlight (2 × 3 pixels at 10⁴ times the wall, its noise half its value) on a wall
+// whose features do not show it, at 8 spp: SVGF's 3×3 blur of the variance gave the wall pixels
+// beside it the highlight's variance, a tolerance wide enough to take its light (6–23 times the
+// wall's noisy error there without the knee, three seeds). With the knee the wall beside it must
+// be no worse than its noisy input, while the wall away from it is still denoised.
+TEST(Atrous, VarianceKneeKeepsASmallHighlightOffTheWallBesideIt) {
+  const int w = 64, h = 64;
+  const auto inHighlight = [](int x, int y) { return x >= 29 && x <= 31 && y >= 30 && y <= 31; };
+  Image truth(w, h, 3), sigma(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        truth(x, y, c) = inHighlight(x, y) ? 1000.0f : 0.1f;
+        sigma(x, y, c) = inHighlight(x, y) ? 500.0f : 0.05f;
+      }
+  SubBuffer features = SubBuffer::zeros(w, h);
+  features.albedo.mean.fill(0.5f);
+  features.depth.mean.fill(2.0f);
+  features.sampleCount.fill(8.0f);
+  for (int i = 0; i < w * h; ++i) features.normal.mean.data()[i * 3 + 2] = 1.0f;
+  for (uint32_t seed = 1; seed <= 3; ++seed) {
+    DenoiseInput input = test::gaussianHalves(truth, sigma, features, seed);
+    input.halves.reset();
+    const Image out = Atrous().run(input);
+    // Squared error over the wall within 2 pixels of the highlight (near) and beyond 8 (far).
+    auto wallError = [&](const Image& image, bool near) {
+      double e = 0;
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const int d = std::max({29 - x, x - 31, 30 - y, y - 31, 0});
+          if (inHighlight(x, y) || (near ? d > 2 : d <= 8)) continue;
+          for (int c = 0; c < 3; ++c) e += std::pow(image(x, y, c) - truth(x, y, c), 2.0);
+        }
+      return e;
+    };
+    const Image& noisy = input.whole.color.mean;
+    EXPECT_LE(wallError(out, true), 1.05 * wallError(noisy, true)) << seed;
+    EXPECT_LT(wallError(out, false), 0.5 * wallError(noisy, false)) << seed;
+  }
+}
+
 // Without `iterations` the levels follow the render's samples per pixel (atrous.h): 5 up to
 // 22 spp, 4 at 32, 3 at 64, 2 from 91 on; a held-out input counts the render's samples.
 TEST(Atrous, LevelsFollowTheRendersSamples) {
@@ -287,11 +330,11 @@ TEST(Atrous, LevelsFollowTheRendersSamples) {
 }
 
 TEST(Atrous, RegistryAndParameters) {
-  test::expectCreates("atrous:iterations=3:sigmaN=64:demodulate=false", "atrous",
+  test::expectCreates("atrous:iterations=3:sigmaN=64:demodulate=false:varianceKnee=0", "atrous",
                       {.features = true, .halves = false});
   test::expectRejected({"atrous:sigmaN=100", "atrous:iterations=-2", "atrous:sigmaL=0",
                         "atrous:symmetricFrom=-1", "atrous:symmetricFrom=nan", "atrous:borrow=-0.1",
-                        "atrous:borrow=1.5", "atrous:borrow=nan"});
+                        "atrous:borrow=1.5", "atrous:borrow=nan", "atrous:varianceKnee=-1"});
   // Zero iterations: the input, exactly (demodulation off).
   test::expectIdentity("atrous:iterations=0:demodulate=false");
 }

@@ -5,15 +5,18 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "common/error.h"
 #include "denoise/base/atrous/atrous_kernel.h"
 #include "denoise/base/buffer_variance.h"
 #include "denoise/base/input_planes.h"
+#include "denoise/base/selection_knee.h"
 #include "denoise/planes/padded_planes.h"
 
 namespace chorus {
@@ -28,6 +31,7 @@ AtrousParams AtrousParams::fromParams(ParamMap& params) {
   p.clampFireflies = params.getBool("clampFireflies", p.clampFireflies);
   p.symmetricFrom = params.getFloat("symmetricFrom", p.symmetricFrom);
   p.borrow = params.getFloat("borrow", p.borrow);
+  p.varianceKnee = params.getFloat("varianceKnee", p.varianceKnee);
   if (p.iterations < kIterationsFromSamples || p.iterations > kMaxIterations)
     throw Error("atrous: iterations must be in [0, " + std::to_string(kMaxIterations) +
                 "], or -1 (from the samples per pixel)");
@@ -35,6 +39,8 @@ AtrousParams AtrousParams::fromParams(ParamMap& params) {
   if (!(p.sigmaL > 0) || !std::isfinite(p.sigmaL)) throw Error("atrous: sigmaL must be > 0");
   if (!(p.symmetricFrom >= 0)) throw Error("atrous: symmetricFrom must be >= 0");
   if (!(p.borrow >= 0 && p.borrow <= 1)) throw Error("atrous: borrow must be in [0, 1]");
+  if (!(p.varianceKnee >= 0) || !std::isfinite(p.varianceKnee))
+    throw Error("atrous: varianceKnee must be 0 (off) or positive");
   // Powers of two only: w_n is then a chain of squarings, which vectorises.
   if (p.sigmaN != 0 && !(p.sigmaN >= 1 && p.sigmaN <= 1024 && p.sigmaN == std::floor(p.sigmaN) &&
                          std::has_single_bit(unsigned(p.sigmaN))))
@@ -174,15 +180,45 @@ using StatisticsLanes = Float4;
 using StatisticsLanes = Float1;
 #endif
 
+enum KneePlane { kKneedVariance, kKneeDivisor, kKneePlanes };
+
+// The level's luminance variance divided by each pixel's knee divisor (selection_knee.h; its
+// level: the luminance) and the divisors, or nothing when no pixel is above the knee.
+std::optional<PaddedPlanes> kneedVariance(const PaddedPlanes& state, float knee) {
+  const int w = state.width(), h = state.height();
+  double sum = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float l = luminanceOf(state, state.index(x, y));
+      if (std::isfinite(l)) sum += std::abs(double(l));
+    }
+  const double level = double(knee) * sum / (double(w) * double(h));
+  if (!(level > 0) || !std::isfinite(level)) return std::nullopt;
+  PaddedPlanes out(w, h, kKneePlanes, state.margin());
+  std::atomic<bool> any{false};
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t i = state.index(x, y);
+      const float d = float(kneeDivisor(luminanceOf(state, i), level));
+      out.plane(kKneeDivisor)[i] = d;
+      out.plane(kKneedVariance)[i] = state.plane(kVariance)[i] / d;
+      if (d != 1.0f) any = true;
+    }
+  });
+  if (!any) return std::nullopt;
+  return out;
+}
+
 // Luminance of rows [first, last) and their inverse tolerance 1 / (σ_l √V + ε_l), with
 // V = max(borrow · B, min(Var, B)) and B = g3×3 ∗ Var (atrous.h; borrow 1: V = B), the 3×3
 // Gaussian (1/4 centre, 1/8 edges, 1/16 corners) clipped and renormalised at the borders,
 // applied separably ([1 2 1] / 4 per axis, / 3 where one side is missing, / 2 with none). Each
-// row is smoothed horizontally once, into a ring of three rows.
-void levelStatistics(const PaddedPlanes& state, float sigmaL, float borrow, int first, int last,
-                     PaddedPlanes& statistics) {
+// row is smoothed horizontally once, into a ring of three rows. With `kneed`, B is smoothed from
+// its variance in relative units and multiplied by the pixel's own divisor.
+void levelStatistics(const PaddedPlanes& state, const PaddedPlanes* kneed, float sigmaL,
+                     float borrow, int first, int last, PaddedPlanes& statistics) {
   const int w = state.width(), h = state.height();
-  const float* variance = state.plane(kVariance);
+  const float* variance = kneed ? kneed->plane(kKneedVariance) : state.plane(kVariance);
   std::vector<float> scratch(size_t(3 * w));
   // Horizontally smoothed variance of rows y − 1, y, y + 1 (zeros outside the image).
   float* ring[3] = {scratch.data(), scratch.data() + w, scratch.data() + 2 * w};
@@ -207,7 +243,8 @@ void levelStatistics(const PaddedPlanes& state, float sigmaL, float borrow, int 
     const float yNorm = axisNorm(y, h);
     float* luminance = statistics.plane(0) + state.index(0, y);
     float* tolerance = statistics.plane(1) + state.index(0, y);
-    const float* ownVariance = variance + state.index(0, y);
+    const float* ownVariance = state.plane(kVariance) + state.index(0, y);
+    const float* divisor = kneed ? kneed->plane(kKneeDivisor) + state.index(0, y) : nullptr;
     const float* color[3] = {state.plane(kRed) + state.index(0, y),
                              state.plane(kGreen) + state.index(0, y),
                              state.plane(kBlue) + state.index(0, y)};
@@ -221,6 +258,7 @@ void levelStatistics(const PaddedPlanes& state, float sigmaL, float borrow, int 
       F g = (F::load(ring[0] + x) + F::broadcast(2.0f) * F::load(ring[1] + x) +
              F::load(ring[2] + x)) *
             F::broadcast(yNorm);
+      if (divisor) g = g * F::load(divisor + x);
       if (borrow < 1) {
         const F own = F::load(ownVariance + x), share = F::broadcast(borrow) * g;
         const F lowered = g - max0(g - own);  // min(own, g)
@@ -243,9 +281,11 @@ void atrousLevel(const Guide& g, const AtrousParams& params, bool symmetric, Atr
                  int step, const PaddedPlanes& state, PaddedPlanes& statistics, PaddedPlanes& next,
                  const std::vector<float>& inside) {
   const int w = state.width(), h = state.height();
+  const std::optional<PaddedPlanes> kneed =
+      params.varianceKnee > 0 ? kneedVariance(state, params.varianceKnee) : std::nullopt;
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
-    levelStatistics(state, params.sigmaL, symmetric ? 1.0f : params.borrow, rows.begin(),
-                    rows.end(), statistics);
+    levelStatistics(state, kneed ? &*kneed : nullptr, params.sigmaL,
+                    symmetric ? 1.0f : params.borrow, rows.begin(), rows.end(), statistics);
   });
 
   // Pointers to pixel (0, 0) of each plane (all planes share the padded layout).

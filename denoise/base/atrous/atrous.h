@@ -33,7 +33,11 @@
 //     neighbours' variance, and with it a tolerance wide enough to take their light
 //     (interior-doorway 16 spp: relMSE 0.48, noisy 0.42; with borrow 0.5: 0.16). Off by default:
 //     better alone and in the preview, but the default ensemble blends worse with it at 4–8 spp
-//     (docs/members/sbf-atrous-bilateral.md).
+//     (docs/members/sbf-atrous-bilateral.md);
+//   - the 3×3 blur of Var_l takes a bright pixel's variance in relative units (divided by
+//     (l / knee)² where l exceeds `varianceKnee` × the level's mean |luminance|, multiplied back
+//     by p's own): blurred as is, a highlight's variance gave the dark pixels beside it a
+//     tolerance wide enough to take its light (selection_knee.h; docs/members/).
 #include <string>
 
 #include "denoise/base/base_denoiser.h"
@@ -58,9 +62,11 @@ struct AtrousParams {
   // Below symmetricFrom, the least share of the 3×3-blurred variance a pixel's tolerance keeps
   // where its own variance is smaller (1: SVGF's blurred variance alone, at any sample count).
   float borrow = 1.0f;
+  // The knee above which the variance blur is relative (0: SVGF's blur everywhere).
+  float varianceKnee = 8.0f;
 
   // Reads overrides: iterations, sigmaZ, sigmaN, sigmaL, demodulate, clampFireflies,
-  // symmetricFrom, borrow.
+  // symmetricFrom, borrow, varianceKnee.
   // Throws chorus::Error for a value out of range.
   static AtrousParams fromParams(ParamMap& params);
 };

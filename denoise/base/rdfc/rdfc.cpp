@@ -130,8 +130,8 @@ Image secondPass(const Image& first1, const Image& first2, const std::vector<Rdf
 
 }  // namespace
 
-// Smoothed as is (knee 0), a highlight's variance at few samples became its
-// dark neighbours' (10⁴ times their own), which made every patch distance to the highlight
+// Smoothed as is (knee 0), a highlight's variance at few samples became its dark neighbours'
+// (orders of magnitude above their own), which made their patch distances to the highlight
 // small, and the second pass spread it into them (a softbox seen in chrome at 4 spp).
 Image rdfcSecondPassVariance(const Image& first1, const Image& first2, const Image& guide,
                              float knee) {

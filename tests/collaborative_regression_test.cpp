@@ -10,6 +10,7 @@
 #include "denoise/base/filters/box_filter.h"
 #include "denoise/base/filters/collaborative_regression.h"
 #include "denoise/base/filters/gram_solver.h"
+#include "tests/support/denoiser_checks.h"
 #include "tests/support/test_support.h"
 
 namespace chorus {
@@ -261,6 +262,26 @@ TEST(CollaborativeRegression, MatchesPerWindowPivotedQr) {
 // NFOR's shape (8 features, RGB) runs a kernel of its own (fixed sizes, sums in register blocks).
 TEST(CollaborativeRegression, MatchesPerWindowPivotedQrInNforsShape) {
   expectMatchesPerWindowPivotedQr(8);
+}
+
+// The Gram sums are blocked for the CPU's vector registers (AVX-512: two design rows over half a
+// group's lanes; otherwise one row over a quarter); every sum adds the same terms in the same
+// order, so both blockings give the same bits, in NFOR's shape and the generic one, for powered
+// weights too. (Whichever blocking this CPU prefers, both run here.)
+TEST(CollaborativeRegression, BothSumBlockingsGiveTheSameBits) {
+  for (int features : {3, 8}) {
+    Scene s = affineScene(37, 23, features, 50);
+    s.image = test::randomImage(37, 23, 3, 51, 0.0f, 2.0f);
+    const NlMeansWeights weights = regressionWeights(s, 4, 0.7f);
+    const int powers[] = {4, 1};
+    const std::vector<Image> wide =
+        collaborativeRegressions(s.image, s.features, weights, powers, {}, GramSumBlocking::Wide);
+    const std::vector<Image> narrow =
+        collaborativeRegressions(s.image, s.features, weights, powers, {}, GramSumBlocking::Narrow);
+    for (size_t i = 0; i < wide.size(); ++i)
+      EXPECT_TRUE(test::bitIdentical(wide[i], narrow[i]))
+          << features << " features, power " << powers[i];
+  }
 }
 
 }  // namespace

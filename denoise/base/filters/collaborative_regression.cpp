@@ -89,17 +89,6 @@ struct Group {
   const BorderedPlanes* fu;  // features (m planes) then data (C planes), zero border ≥ r + kLanes
 };
 
-// The design-matrix row of window offset δ = (dx, dy) for the kLanes centres:
-// x = [1, dx, dy, f_j(q) − f_j(p) …] with q = p + δ (d columns).
-[[gnu::always_inline]] inline void designRow(const Group& g, int d, const Lanes* fp, int dx, int dy,
-                                             Lanes* x) {
-  x[0] = splat(1.0f);
-  x[1] = splat(float(dx));
-  x[2] = splat(float(dy));
-  for (int j = 0; j < d - 3; ++j)
-    x[3 + j] = loadVector<Lanes>(g.fu->row(j, g.y + dy) + g.x0 + dx) - fp[j];
-}
-
 [[gnu::always_inline]] inline void centreFeatures(const Group& g, int d, Lanes* fp) {
   for (int j = 0; j < d - 3; ++j) fp[j] = loadVector<Lanes>(g.fu->row(j, g.y) + g.x0);
 }
@@ -143,40 +132,65 @@ struct OffsetColumns {
   double x[kMaxColumns][kHalf];
 };
 
-// The design rows a ≠ 2 of the Gram sums in blocks of two: {0, 1}, {3, 4}, {5, 6}, …
-constexpr int rowBlocks(int d) {
-  return d / 2;
+// How the Gram sums of a window row are blocked: Sub holds `width` of a half's lanes (one vector
+// register), and each block sums kRows design rows a ≠ 2 against every column, its accumulators
+// (up to kRows × 13 registers for NFOR) held in registers over the row. AVX-512 (32 registers):
+// the whole half, two rows a block ({0, 1}, {3, 4}, {5, 6}, …). AVX2 (16 registers): a quarter
+// of the group, one row a block ({0}, {1}, {3}, …), since 26 accumulators of two registers each
+// spilled on every offset (5× slower). Every sum adds the same terms in the same order
+// either way, so both give the same bits.
+using QuarterSums = double __attribute__((vector_size(kHalf / 2 * sizeof(double))));
+// (The vector types are declared here: GCC drops vector_size on a type that depends on a
+// template parameter.)
+template <typename SubSums, int kRows>
+struct SumBlocks {
+  using Sub = SubSums;
+  static constexpr int width = int(sizeof(Sub) / sizeof(double)), rowsPerBlock = kRows;
+  static constexpr int blocks(int d) { return kRows == 2 ? d / 2 : d - 1; }
+  // The first design row of block k (the second, if any, is the next one above 2).
+  static constexpr int firstRow(int k) {
+    if (kRows == 2) return k == 0 ? 0 : 2 * k + 1;
+    return k < 2 ? k : k + 1;
+  }
+};
+using WideBlocks = SumBlocks<HalfSums, 2>;
+using NarrowBlocks = SumBlocks<QuarterSums, 1>;
+
+template <typename V>
+[[gnu::always_inline]] inline void addTo(double* sum, V v) {
+  storeVector(sum, loadVector<V>(sum) + v);
 }
 
-[[gnu::always_inline]] inline void addTo(double* sum, HalfSums v) {
-  storeVector(sum, loadVector<HalfSums>(sum) + v);
-}
-
-// The window row dy's part of the sums (a, b) with a in block k: the row's sum
-// Σ_dx w · x_a · x_b over its `live` offsets (in order) for every b ≥ a, b ≠ 2 — a block of
-// accumulators that stays in registers over the row, instead of every sum loaded and stored
-// at every offset — is added to sums[sumIndex(a, b)]. Block 0 also adds the sums with the dy
-// column (a or b = 2): dy times the row's sums with column 0.
+// The window row dy's part of the sums (a, b) with a in block k, for the lanes lane0 …
+// lane0 + width − 1 of a half: the row's sum Σ_dx w · x_a · x_b over its `live` offsets (in
+// order) for every b ≥ a, b ≠ 2 — a block of accumulators that stays in registers over the
+// row, instead of every sum loaded and stored at every offset — is added to
+// sums[sumIndex(a, b)]. Block 0 also adds the sums with the dy column (a or b = 2): dy times the
+// row's sums with column 0.
+template <typename Blocks>
 [[gnu::always_inline]] inline void rowBlockSums(int d, int total, int k, const OffsetColumns* cols,
-                                                int live, int dy, double (*sums)[kHalf]) {
-  const int a0 = k == 0 ? 0 : 2 * k + 1, a1 = k == 0 ? 1 : 2 * k + 2;
-  const int rows = a1 < d ? 2 : 1;
+                                                int live, int dy, int lane0,
+                                                double (*sums)[kHalf]) {
+  using Sub = typename Blocks::Sub;
+  constexpr int kRows = Blocks::rowsPerBlock;
+  const int a0 = Blocks::firstRow(k), a1 = a0 + 1 == 2 ? 3 : a0 + 1;
+  const int rows = kRows == 2 && a1 < d ? 2 : 1;
   const int rowOf[2] = {a0, a1};
-  HalfSums acc[2][kMaxColumns];
+  Sub acc[kRows][kMaxColumns];
 #pragma GCC unroll 2
   for (int r = 0; r < rows; ++r)
 #pragma GCC unroll 32
-    for (int b = a0; b < total; ++b) acc[r][b] = HalfSums{};
+    for (int b = a0; b < total; ++b) acc[r][b] = Sub{};
   for (int i = 0; i < live; ++i) {
     const OffsetColumns& o = cols[i];
-    HalfSums wa[2] = {};
+    Sub wa[kRows] = {};
 #pragma GCC unroll 2
     for (int r = 0; r < rows; ++r)
-      wa[r] = loadVector<HalfSums>(o.w) * loadVector<HalfSums>(o.x[rowOf[r]]);
+      wa[r] = loadVector<Sub>(o.w + lane0) * loadVector<Sub>(o.x[rowOf[r]] + lane0);
 #pragma GCC unroll 32
     for (int b = a0; b < total; ++b) {
       if (b == 2) continue;
-      const HalfSums xb = loadVector<HalfSums>(o.x[b]);
+      const Sub xb = loadVector<Sub>(o.x[b] + lane0);
 #pragma GCC unroll 2
       for (int r = 0; r < rows; ++r)
         if (b >= rowOf[r]) acc[r][b] += wa[r] * xb;
@@ -186,22 +200,22 @@ constexpr int rowBlocks(int d) {
   for (int r = 0; r < rows; ++r)
 #pragma GCC unroll 32
     for (int b = rowOf[r]; b < total; ++b)
-      if (b != 2) addTo(sums[sumIndex(total, rowOf[r], b)], acc[r][b]);
+      if (b != 2) addTo(sums[sumIndex(total, rowOf[r], b)] + lane0, acc[r][b]);
   if (k == 0) {
-    const HalfSums rowDy = HalfSums{} + double(dy), withDy = rowDy * acc[0][0];
-    addTo(sums[sumIndex(total, 0, 2)], withDy);
-    addTo(sums[sumIndex(total, 1, 2)], rowDy * acc[0][1]);
-    addTo(sums[sumIndex(total, 2, 2)], rowDy * withDy);
+    const Sub rowDy = Sub{} + double(dy), withDy = rowDy * acc[0][0];
+    addTo(sums[sumIndex(total, 0, 2)] + lane0, withDy);
+    addTo(sums[sumIndex(total, 1, 2)] + lane0, rowDy * acc[0][1]);
+    addTo(sums[sumIndex(total, 2, 2)] + lane0, rowDy * withDy);
 #pragma GCC unroll 32
-    for (int b = 3; b < total; ++b) addTo(sums[sumIndex(total, 2, b)], rowDy * acc[0][b]);
+    for (int b = 3; b < total; ++b) addTo(sums[sumIndex(total, 2, b)] + lane0, rowDy * acc[0][b]);
   }
 }
 
-template <int kD, int kC, int... kBlock>
+template <typename Blocks, int kD, int kC, int... kBlock>
 [[gnu::always_inline]] inline void allRowBlockSums(std::integer_sequence<int, kBlock...>,
                                                    const OffsetColumns* cols, int live, int dy,
-                                                   double (*sums)[kHalf]) {
-  (rowBlockSums(kD, kD + kC, kBlock, cols, live, dy, sums), ...);
+                                                   int lane0, double (*sums)[kHalf]) {
+  (rowBlockSums<Blocks>(kD, kD + kC, kBlock, cols, live, dy, lane0, sums), ...);
 }
 
 // The Gram sums of a group, in double: half[h][e] holds sum e (see kMaxSums) of the lanes
@@ -215,6 +229,12 @@ struct GroupSums {
 struct WindowRowScratch {
   std::vector<OffsetColumns> columns;
 };
+
+// A half's column of equal values, in quarter vectors: an 8-double splat built for AVX2 went
+// through the stack in scalar stores, and the wide loads that followed stalled on them.
+[[gnu::always_inline]] inline void fillColumn(double* x, double v) {
+  for (int i = 0; i < kHalf; i += kHalf / 2) storeVector(x + i, QuarterSums{} + v);
+}
 
 // Stores the lanes of v as the two halves' columns.
 [[gnu::always_inline]] inline void storeHalves(double* lo, double* hi, SumLanes v) {
@@ -232,7 +252,7 @@ struct WindowRowScratch {
 // formed once per row instead of at every offset. The weights are also copied to
 // `groupWeights` (w_δ at offsetIndex(δ) · kLanes) for the predictions: the table's planes are
 // far apart, and this way it is read only once.
-template <int kD, int kC>
+template <typename Blocks, int kD, int kC>
 [[gnu::always_inline]] inline void accumulateSumsOf(const Group& g, GroupSums& sums,
                                                     float* groupWeights, uint8_t* skip,
                                                     WindowRowScratch& scratch) {
@@ -265,10 +285,10 @@ template <int kD, int kC>
       OffsetColumns &lo = cols[0][live], &hi = cols[1][live];
       ++live;
       storeHalves(lo.w, hi.w, wide(w));
-      storeVector(lo.x[0], HalfSums{} + 1.0);
-      storeVector(hi.x[0], HalfSums{} + 1.0);
-      storeVector(lo.x[1], HalfSums{} + double(float(dx)));
-      storeVector(hi.x[1], HalfSums{} + double(float(dx)));
+      fillColumn(lo.x[0], 1.0);
+      fillColumn(hi.x[0], 1.0);
+      fillColumn(lo.x[1], double(float(dx)));
+      fillColumn(hi.x[1], double(float(dx)));
 #pragma GCC unroll 32
       for (int j = 0; j < d - 3; ++j)
         storeHalves(lo.x[3 + j], hi.x[3 + j], wide(loadVector<Lanes>(planes[3 + j] + dx) - fp[j]));
@@ -277,23 +297,34 @@ template <int kD, int kC>
         storeHalves(lo.x[d + c], hi.x[d + c], wide(loadVector<Lanes>(planes[d + c] + dx)));
     }
     if (live == 0) continue;  // the row would add 0 to every sum
-    for (int h = 0; h < 2; ++h) {
-      if constexpr (kD > 0)
-        allRowBlockSums<kD, kC>(std::make_integer_sequence<int, rowBlocks(kD)>{}, cols[h], live, dy,
-                                sums.half[h]);
-      else
-        for (int k = 0; k < rowBlocks(d); ++k)
-          rowBlockSums(d, total, k, cols[h], live, dy, sums.half[h]);
-    }
+    for (int h = 0; h < 2; ++h)
+      for (int lane0 = 0; lane0 < kHalf; lane0 += Blocks::width) {
+        if constexpr (kD > 0)
+          allRowBlockSums<Blocks, kD, kC>(std::make_integer_sequence<int, Blocks::blocks(kD)>{},
+                                          cols[h], live, dy, lane0, sums.half[h]);
+        else
+          for (int k = 0; k < Blocks::blocks(d); ++k)
+            rowBlockSums<Blocks>(d, total, k, cols[h], live, dy, lane0, sums.half[h]);
+      }
   }
 }
 
-CHORUS_SIMD_CLONES void accumulateSums(const Group& g, GroupSums& sums, float* groupWeights,
-                                       uint8_t* skip, WindowRowScratch& scratch) {
+template <typename Blocks>
+[[gnu::always_inline]] inline void accumulateSumsIn(const Group& g, GroupSums& sums,
+                                                    float* groupWeights, uint8_t* skip,
+                                                    WindowRowScratch& scratch) {
   if (g.d == kNforColumns && g.channels == kNforChannels)
-    accumulateSumsOf<kNforColumns, kNforChannels>(g, sums, groupWeights, skip, scratch);
+    accumulateSumsOf<Blocks, kNforColumns, kNforChannels>(g, sums, groupWeights, skip, scratch);
   else
-    accumulateSumsOf<0, 0>(g, sums, groupWeights, skip, scratch);
+    accumulateSumsOf<Blocks, 0, 0>(g, sums, groupWeights, skip, scratch);
+}
+
+CHORUS_SIMD_CLONES void accumulateSums(const Group& g, GroupSums& sums, float* groupWeights,
+                                       uint8_t* skip, WindowRowScratch& scratch, bool wide) {
+  if (wide)
+    accumulateSumsIn<WideBlocks>(g, sums, groupWeights, skip, scratch);
+  else
+    accumulateSumsIn<NarrowBlocks>(g, sums, groupWeights, skip, scratch);
 }
 
 // acc_c(q) += w_δ(p) · x_qᵀ β_c(p) and wsum(q) += w_δ(p) for every q = p + δ of the group's
@@ -306,20 +337,32 @@ template <int kD, int kC>
                                                            float* acc, size_t accWidth,
                                                            size_t accPlane, size_t accAt) {
   const int d = kD ? kD : g.d, C = kD ? kC : g.channels;
-  Lanes fp[kMaxGramSize], x[kMaxColumns];
+  Lanes fp[kMaxGramSize];
   centreFeatures(g, d, fp);
   for (int dy = -g.r; dy <= g.r; ++dy)
     for (int dx = -g.r; dx <= g.r; ++dx) {
       const Lanes w = loadVector<Lanes>(groupWeights);
       groupWeights += kLanes;
       if (*skip++) continue;
-      designRow(g, d, fp, dx, dy, x);
+      // p_c = x_qᵀ β_c with the design row x_q = [1, dx, dy, f_j(q) − f_j(p) …], column by
+      // column (x_0 = 1) for every channel at once, so that only the C predictions are live
+      // across the row; each p_c adds its terms in order of a, as the Gram sums did.
+      Lanes p[kMaxGramRhs];
+#pragma GCC unroll 4
+      for (int c = 0; c < C; ++c) p[c] = beta[c];
+#pragma GCC unroll 32
+      for (int a = 1; a < d; ++a) {
+        const Lanes xa =
+            a == 1   ? splat(float(dx))
+            : a == 2 ? splat(float(dy))
+                     : loadVector<Lanes>(g.fu->row(a - 3, g.y + dy) + g.x0 + dx) - fp[a - 3];
+#pragma GCC unroll 4
+        for (int c = 0; c < C; ++c) p[c] += beta[a * C + c] * xa;
+      }
       float* at = acc + accAt + ptrdiff_t(dy) * ptrdiff_t(accWidth) + dx;
       for (int c = 0; c < C; ++c) {
-        Lanes p = beta[c];
-        for (int a = 1; a < d; ++a) p += beta[a * C + c] * x[a];
         float* plane = at + size_t(c) * accPlane;
-        storeVector(plane, loadVector<Lanes>(plane) + w * p);
+        storeVector(plane, loadVector<Lanes>(plane) + w * p[c]);
       }
       float* wsum = at + size_t(C) * accPlane;
       storeVector(wsum, loadVector<Lanes>(wsum) + w);
@@ -352,11 +395,23 @@ struct ThreadState {
   std::vector<uint8_t> skip;        // per offset: every weight of the group is 0
 };
 
+// AVX-512F: 32 vector registers of 8 doubles (WideBlocks); otherwise NarrowBlocks.
+bool cpuHasWideVectors() {
+#if defined(__x86_64__) && defined(__GNUC__)
+  static const bool wide = __builtin_cpu_supports("avx512f");
+  return wide;
+#else
+  return false;
+#endif
+}
+
 class Regression {
  public:
   Regression(const Image& image, const Image& features, const NlMeansWeights& weights,
-             std::span<const int> powers, const GramTolerances& tol)
-      : weights_(weights),
+             std::span<const int> powers, const GramTolerances& tol, GramSumBlocking blocking)
+      : wide_(blocking == GramSumBlocking::Wide ||
+              (blocking == GramSumBlocking::ForThisCpu && cpuHasWideVectors())),
+        weights_(weights),
         powers_(powers.begin(), powers.end()),
         tol_(tol),
         width_(image.width()),
@@ -444,7 +499,7 @@ class Regression {
             .centreFloor = weights_.params().minCenterWeight,
             .insideLanes = std::min(kLanes, width_ - x0),
             .fu = &fu_};
-        accumulateSums(g, st.sums, st.groupWeights.data(), st.skip.data(), st.windowRow);
+        accumulateSums(g, st.sums, st.groupWeights.data(), st.skip.data(), st.windowRow, wide_);
         // Declared in baseline code, where alignof(Lanes) is only 16, and read by the AVX-512
         // clone of accumulatePredictions, which may assume the type's full 64 bytes.
         alignas(64) Lanes beta[kMaxGramSize * kMaxGramRhs];
@@ -506,6 +561,7 @@ class Regression {
     return result;
   }
 
+  bool wide_;  // WideBlocks (AVX-512) or NarrowBlocks
   const NlMeansWeights& weights_;
   std::vector<int> powers_;
   GramTolerances tol_;
@@ -531,21 +587,24 @@ void checkRegressionInputs(const Image& image, const Image& features,
 }  // namespace
 
 Image collaborativeRegression(const Image& image, const Image& features,
-                              const NlMeansWeights& weights, const GramTolerances& tolerances) {
+                              const NlMeansWeights& weights, const GramTolerances& tolerances,
+                              GramSumBlocking blocking) {
   checkRegressionInputs(image, features, weights);
   const int one = 1;
-  return Regression(image, features, weights, std::span<const int>(&one, 1), tolerances).run()[0];
+  return Regression(image, features, weights, std::span<const int>(&one, 1), tolerances, blocking)
+      .run()[0];
 }
 
 std::vector<Image> collaborativeRegressions(const Image& image, const Image& features,
                                             const NlMeansWeights& weights,
                                             std::span<const int> powers,
-                                            const GramTolerances& tolerances) {
+                                            const GramTolerances& tolerances,
+                                            GramSumBlocking blocking) {
   for (int p : powers)
     if (p < 1 || p > kMaxWeightPower)
       throw std::invalid_argument("collaborativeRegressions: power out of range");
   checkRegressionInputs(image, features, weights);
-  return Regression(image, features, weights, powers, tolerances).run();
+  return Regression(image, features, weights, powers, tolerances, blocking).run();
 }
 
 }  // namespace chorus

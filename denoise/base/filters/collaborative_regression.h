@@ -19,11 +19,16 @@
 
 namespace chorus {
 
+// How the Gram sums are blocked in vector registers: for this CPU's vector width by default
+// (AVX-512: Wide; otherwise Narrow). Both give the same bits (tests run both).
+enum class GramSumBlocking { ForThisCpu, Wide, Narrow };
+
 // `image`: the data u (≤ 4 channels); `features`: m channels (m ≤ 21), one per regressor,
 // non-finite values are treated as 0; `weights`: scalar weights of the image's size, whose
 // window radius r is the regression window. Throws std::invalid_argument on mismatches.
 Image collaborativeRegression(const Image& image, const Image& features,
-                              const NlMeansWeights& weights, const GramTolerances& tolerances = {});
+                              const NlMeansWeights& weights, const GramTolerances& tolerances = {},
+                              GramSumBlocking blocking = GramSumBlocking::ForThisCpu);
 
 inline constexpr int kMaxWeightPower = 16;
 
@@ -35,6 +40,7 @@ inline constexpr int kMaxWeightPower = 16;
 std::vector<Image> collaborativeRegressions(const Image& image, const Image& features,
                                             const NlMeansWeights& weights,
                                             std::span<const int> powers,
-                                            const GramTolerances& tolerances = {});
+                                            const GramTolerances& tolerances = {},
+                                            GramSumBlocking blocking = GramSumBlocking::ForThisCpu);
 
 }  // namespace chorus

@@ -5,8 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <cmath>
 #include <iostream>
 
 #include "denoise/metrics/metrics.h"
@@ -28,38 +26,14 @@ constexpr double kMinImprovement = 6.0;
 // the knee the wall around it must be no worse than its noisy input, while the wall away from
 // it is still denoised.
 TEST(JointNlMeans, KeepsASmallHighlightOffTheWallAroundIt) {
-  const int w = 64, h = 64;
-  const auto inHighlight = [](int x, int y) { return x >= 19 && x <= 21 && y >= 11 && y <= 12; };
-  Image truth(w, h, 3), sigma(w, h, 3);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c) {
-        truth(x, y, c) = inHighlight(x, y) ? 1000.0f : 0.1f;
-        sigma(x, y, c) = inHighlight(x, y) ? 500.0f : 0.05f;
-      }
-  SubBuffer features = SubBuffer::zeros(w, h);
-  for (float& v : features.albedo.mean.values()) v = 0.5f;
-  for (int i = 0; i < w * h; ++i) features.normal.mean.data()[i * 3 + 2] = 1.0f;
-  for (float& v : features.depth.mean.values()) v = 2.0f;
-  for (float& v : features.visibility.mean.values()) v = 1.0f;
-  for (float& v : features.sampleCount.values()) v = 8.0f;
+  const test::HighlightOnWall scene = test::highlightOnWall(19, 11);
+  const SubBuffer features = test::flatFeatures(64, 64, 8.0f);
   for (uint32_t seed = 1; seed <= 3; ++seed) {
-    const DenoiseInput input = test::gaussianHalves(truth, sigma, features, seed);
+    const DenoiseInput input = test::gaussianHalves(scene.truth, scene.sigma, features, seed);
     const Image out = runJointNlMeans(input, JointNlMeansParams{});
-    // Squared error over the wall within 2 pixels of the highlight (near) and beyond 8 (far).
-    auto wallError = [&](const Image& image, bool near) {
-      double e = 0;
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-          const int d = std::max({19 - x, x - 21, 11 - y, y - 12, 0});
-          if (inHighlight(x, y) || (near ? d > 2 : d <= 8)) continue;
-          for (int c = 0; c < 3; ++c) e += std::pow(image(x, y, c) - truth(x, y, c), 2.0);
-        }
-      return e;
-    };
     const Image& noisy = input.whole.color.mean;
-    EXPECT_LE(wallError(out, true), 1.05 * wallError(noisy, true)) << seed;
-    EXPECT_LT(wallError(out, false), 0.5 * wallError(noisy, false)) << seed;
+    EXPECT_LE(scene.wallError(out, true), 1.05 * scene.wallError(noisy, true)) << seed;
+    EXPECT_LT(scene.wallError(out, false), 0.5 * scene.wallError(noisy, false)) << seed;
   }
 }
 

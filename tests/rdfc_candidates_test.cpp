@@ -124,13 +124,7 @@ TEST(RdfcCandidates, SelectionPicksTheCandidateWithTheLowerTrueError) {
         truth(x, y, c) = x < w / 2 ? 0.2f : 1.0f;
         sigma(x, y, c) = 0.03f;
       }
-  SubBuffer features = SubBuffer::zeros(w, h);
-  for (float& v : features.albedo.mean.values()) v = 0.5f;
-  for (int i = 0; i < w * h; ++i) features.normal.mean.data()[i * 3 + 2] = 1.0f;
-  for (float& v : features.depth.mean.values()) v = 2.0f;
-  for (float& v : features.visibility.mean.values()) v = 1.0f;
-  for (float& v : features.sampleCount.values()) v = 8.0f;
-  const DenoiseInput input = test::gaussianHalves(truth, sigma, features, 7);
+  const DenoiseInput input = test::gaussianHalves(truth, sigma, test::flatFeatures(w, h, 8.0f), 7);
   RdfcParams params;
   params.rescaleVariance = false;  // independent noise: σ² is the variance
   const RdfcResult result = runRdfc(input, params);

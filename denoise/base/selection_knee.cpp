@@ -22,11 +22,13 @@ double kneeDivisor(double level, double kneeLevel) {
 std::vector<float> kneeDivisors(const Image& rgb, double kneeLevel) {
   std::vector<float> divisors(rgb.pixelCount(), 1.0f);
   if (!(kneeLevel > 0)) return divisors;
-  for (size_t i = 0; i < divisors.size(); ++i) {
-    const float* p = rgb.data() + 3 * i;
-    divisors[i] = float(kneeDivisor((double(p[0]) + p[1] + p[2]) / 3.0, kneeLevel));
-  }
+  for (size_t i = 0; i < divisors.size(); ++i)
+    divisors[i] = float(kneeDivisor(rgbLevel(rgb, i), kneeLevel));
   return divisors;
+}
+
+void divideByPixel(Image& rgb, std::span<const float> divisors) {
+  for (size_t k = 0; k < rgb.size(); ++k) rgb.data()[k] /= divisors[k / 3];
 }
 
 }  // namespace chorus

@@ -1,13 +1,13 @@
 #pragma once
-// A knee for members that choose per pixel among candidates by a smoothed error estimate (NFOR's
-// two bandwidths, SBF's filter widths, RDFC's three candidates). Not in the published methods:
-// the smoothing reaches a dark pixel's neighbours through weights that a few bright, noisy pixels
-// barely move (NFOR's patch distances; SBF's features, which do not show a highlight in a mirror;
-// RDFC's colour patches at a light's edge at few samples), and their errors, in absolute units,
-// are thousands of times the dark pixel's own, so they choose its candidate (a softbox seen in
-// chrome at 4 spp: the wide candidates were chosen around it, where they spread the highlight;
-// docs/members/nfor-nlm.md). Above `knee` times the image's mean |colour| a pixel's errors are
-// divided by (level / that)²: relative error above the knee, absolute (the published methods')
+// A knee for members whose smoothing or patch distances let a few bright, noisy pixels reach
+// their dark neighbours. Not in the published methods. Errors chosen between (NFOR's bandwidths,
+// SBF's filter widths, RDFC's candidates) are smoothed through weights that such pixels barely
+// move, and their errors, in absolute units, are thousands of times the dark pixel's own, so they
+// choose its candidate (a softbox seen in chrome at 4 spp: the wide candidates were chosen around
+// it, where they spread the highlight; docs/members/nfor-nlm.md). Variances (RDFC's second pass,
+// JNLM's patch distances, à-trous's blur) let a highlight's noise excuse its difference from the
+// pixels beside it. Above `knee` times the image's mean |colour| a pixel's errors or variance are
+// divided by (level / that)²: relative units above the knee, absolute (the published methods')
 // below it. Invariant to the unit of radiance.
 #include <cstddef>
 #include <limits>
@@ -18,13 +18,25 @@
 
 namespace chorus {
 
+// A knee parameter is 0 (off) or a finite positive multiple of the image's mean |colour|.
+inline bool validKnee(float knee) {
+  return knee >= 0 && knee <= std::numeric_limits<float>::max();
+}
+
 // knee × the mean |value| of `colour` (non-finite values count as 0): the level above which a
 // pixel's errors become relative. 0 when knee ≤ 0 or the image is black (the knee is off).
 double kneeLevel(std::span<const float> colour, float knee);
 // What a pixel at `level` divides its errors by: (level / kneeLevel)² above the knee, else 1.
 double kneeDivisor(double level, double kneeLevel);
-// kneeDivisor of every pixel of an RGB image whose level is the mean of its three channels.
+// A pixel's level in an interleaved RGB image: the mean of its three channels.
+inline double rgbLevel(const Image& rgb, size_t pixel) {
+  const float* p = rgb.data() + 3 * pixel;
+  return (double(p[0]) + p[1] + p[2]) / 3.0;
+}
+// kneeDivisor of every pixel of an RGB image at its rgbLevel.
 std::vector<float> kneeDivisors(const Image& rgb, double kneeLevel);
+// Every value of an RGB image divided by its pixel's divisor.
+void divideByPixel(Image& rgb, std::span<const float> divisors);
 
 // Every error map's element e divided by kneeDivisor(level(e), kneeLevel), for e < count; an
 // element at FLT_MAX (a member's mark for "unusable") stays. NFOR: its two bandwidths' MSE maps,

@@ -1,5 +1,6 @@
 #include "tests/support/gaussian_buffers.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -29,6 +30,38 @@ DenoiseInput gaussianHalves(const Image& truth, const Image& sigma, const SubBuf
     input.whole.color.varianceOfMean.data()[k] = s * s;
   }
   return input;
+}
+
+SubBuffer flatFeatures(int width, int height, float samples) {
+  SubBuffer features = SubBuffer::zeros(width, height);
+  features.albedo.mean.fill(0.5f);
+  for (int i = 0; i < width * height; ++i) features.normal.mean.data()[i * 3 + 2] = 1.0f;
+  features.depth.mean.fill(2.0f);
+  features.visibility.mean.fill(1.0f);
+  features.sampleCount.fill(samples);
+  return features;
+}
+
+HighlightOnWall highlightOnWall(int x0, int y0) {
+  HighlightOnWall scene{x0, y0, Image(64, 64, 3), Image(64, 64, 3)};
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c) {
+        scene.truth(x, y, c) = scene.inHighlight(x, y) ? 1000.0f : 0.1f;
+        scene.sigma(x, y, c) = scene.inHighlight(x, y) ? 500.0f : 0.05f;
+      }
+  return scene;
+}
+
+double HighlightOnWall::wallError(const Image& image, bool near) const {
+  double e = 0;
+  for (int y = 0; y < truth.height(); ++y)
+    for (int x = 0; x < truth.width(); ++x) {
+      const int d = std::max({x0 - x, x - (x0 + 2), y0 - y, y - (y0 + 1), 0});
+      if (inHighlight(x, y) || (near ? d > 2 : d <= 8)) continue;
+      for (int c = 0; c < 3; ++c) e += std::pow(image(x, y, c) - truth(x, y, c), 2.0);
+    }
+  return e;
 }
 
 }  // namespace chorus::test

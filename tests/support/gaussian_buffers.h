@@ -15,4 +15,20 @@ namespace chorus::test {
 DenoiseInput gaussianHalves(const Image& truth, const Image& sigma, const SubBuffer& features,
                             uint32_t seed);
 
+// Features of one flat, featureless surface: albedo 0.5, normal +z, depth 2, visibility 1, and
+// `samples` samples per pixel.
+SubBuffer flatFeatures(int width, int height, float samples);
+
+// A small highlight on a wall that its features do not show (the members' highlight tests): a
+// 64 × 64 wall of 0.1 (σ 0.05) with pixels [x0, x0 + 2] × [y0, y0 + 1] at 1000 (σ 500).
+struct HighlightOnWall {
+  int x0, y0;
+  Image truth, sigma;
+
+  bool inHighlight(int x, int y) const { return x >= x0 && x <= x0 + 2 && y >= y0 && y <= y0 + 1; }
+  // Squared error of `image` over the wall within 2 pixels of the highlight (near) or beyond 8.
+  double wallError(const Image& image, bool near) const;
+};
+HighlightOnWall highlightOnWall(int x0, int y0);
+
 }  // namespace chorus::test

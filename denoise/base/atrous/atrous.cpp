@@ -5,11 +5,9 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <vector>
 
 #include "common/error.h"
@@ -39,8 +37,7 @@ AtrousParams AtrousParams::fromParams(ParamMap& params) {
   if (!(p.sigmaL > 0) || !std::isfinite(p.sigmaL)) throw Error("atrous: sigmaL must be > 0");
   if (!(p.symmetricFrom >= 0)) throw Error("atrous: symmetricFrom must be >= 0");
   if (!(p.borrow >= 0 && p.borrow <= 1)) throw Error("atrous: borrow must be in [0, 1]");
-  if (!(p.varianceKnee >= 0) || !std::isfinite(p.varianceKnee))
-    throw Error("atrous: varianceKnee must be 0 (off) or positive");
+  if (!validKnee(p.varianceKnee)) throw Error("atrous: varianceKnee must be 0 (off) or positive");
   // Powers of two only: w_n is then a chain of squarings, which vectorises.
   if (p.sigmaN != 0 && !(p.sigmaN >= 1 && p.sigmaN <= 1024 && p.sigmaN == std::floor(p.sigmaN) &&
                          std::has_single_bit(unsigned(p.sigmaN))))
@@ -182,31 +179,35 @@ using StatisticsLanes = Float1;
 
 enum KneePlane { kKneedVariance, kKneeDivisor, kKneePlanes };
 
-// The level's luminance variance divided by each pixel's knee divisor (selection_knee.h; its
-// level: the luminance) and the divisors, or nothing when no pixel is above the knee.
-std::optional<PaddedPlanes> kneedVariance(const PaddedPlanes& state, float knee) {
+// Scratch of the variance knee, allocated once per run: the level's luminance (contiguous, for
+// kneeLevel) and, in the state's padded layout, its variance divided by each pixel's knee
+// divisor and the divisors.
+struct KneeScratch {
+  std::vector<float> luminance;
+  PaddedPlanes planes;
+};
+
+// Fills `scratch` for this level (selection_knee.h; a pixel's level: its luminance); false
+// where the knee is off (knee 0 or a black level), and the plain variance is blurred.
+bool kneedVariance(const PaddedPlanes& state, float knee, KneeScratch& scratch) {
   const int w = state.width(), h = state.height();
-  double sum = 0;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const float l = luminanceOf(state, state.index(x, y));
-      if (std::isfinite(l)) sum += std::abs(double(l));
-    }
-  const double level = double(knee) * sum / (double(w) * double(h));
-  if (!(level > 0) || !std::isfinite(level)) return std::nullopt;
-  PaddedPlanes out(w, h, kKneePlanes, state.margin());
-  std::atomic<bool> any{false};
+  scratch.luminance.resize(size_t(w) * size_t(h));
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x)
+      scratch.luminance[size_t(y) * size_t(w) + size_t(x)] = luminanceOf(state, state.index(x, y));
+  });
+  const double level = kneeLevel(scratch.luminance, knee);
+  if (!(level > 0)) return false;
   tbb::parallel_for(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const size_t i = state.index(x, y);
-      const float d = float(kneeDivisor(luminanceOf(state, i), level));
-      out.plane(kKneeDivisor)[i] = d;
-      out.plane(kKneedVariance)[i] = state.plane(kVariance)[i] / d;
-      if (d != 1.0f) any = true;
+      const float d =
+          float(kneeDivisor(scratch.luminance[size_t(y) * size_t(w) + size_t(x)], level));
+      scratch.planes.plane(kKneeDivisor)[i] = d;
+      scratch.planes.plane(kKneedVariance)[i] = state.plane(kVariance)[i] / d;
     }
   });
-  if (!any) return std::nullopt;
-  return out;
+  return true;
 }
 
 // Luminance of rows [first, last) and their inverse tolerance 1 / (σ_l √V + ε_l), with
@@ -276,15 +277,15 @@ void levelStatistics(const PaddedPlanes& state, const PaddedPlanes* kneed, float
 }
 
 // One à-trous level with tap spacing `step`: state → next (colour and luminance variance).
-// `statistics` is scratch for the level's luminance and inverse luminance tolerance.
+// `statistics` is scratch for the level's luminance and inverse luminance tolerance, `knee`
+// for the variance knee (unused when params.varianceKnee is 0).
 void atrousLevel(const Guide& g, const AtrousParams& params, bool symmetric, AtrousKernelPath path,
-                 int step, const PaddedPlanes& state, PaddedPlanes& statistics, PaddedPlanes& next,
-                 const std::vector<float>& inside) {
+                 int step, const PaddedPlanes& state, PaddedPlanes& statistics, KneeScratch& knee,
+                 PaddedPlanes& next, const std::vector<float>& inside) {
   const int w = state.width(), h = state.height();
-  const std::optional<PaddedPlanes> kneed =
-      params.varianceKnee > 0 ? kneedVariance(state, params.varianceKnee) : std::nullopt;
+  const bool kneed = params.varianceKnee > 0 && kneedVariance(state, params.varianceKnee, knee);
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
-    levelStatistics(state, kneed ? &*kneed : nullptr, params.sigmaL,
+    levelStatistics(state, kneed ? &knee.planes : nullptr, params.sigmaL,
                     symmetric ? 1.0f : params.borrow, rows.begin(), rows.end(), statistics);
   });
 
@@ -424,8 +425,10 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& given, AtrousKernel
     for (int y = 0; y < h; ++y) std::fill_n(statistics.plane(2) + statistics.index(0, y), w, 0.0f);
   std::vector<float> inside(size_t(w + 2 * margin), 0.0f);
   std::fill(inside.begin() + margin, inside.begin() + margin + w, 1.0f);
+  KneeScratch knee;
+  if (params.varianceKnee > 0) knee.planes = PaddedPlanes(w, h, kKneePlanes, margin);
   for (int i = 0; i < params.iterations; ++i) {
-    atrousLevel(guide, params, symmetric, path, 1 << i, state, statistics, next, inside);
+    atrousLevel(guide, params, symmetric, path, 1 << i, state, statistics, knee, next, inside);
     std::swap(state, next);
   }
 

@@ -147,7 +147,7 @@ struct SumBlocks {
   using Sub = SubSums;
   static constexpr int width = int(sizeof(Sub) / sizeof(double)), rowsPerBlock = kRows;
   static constexpr int blocks(int d) { return kRows == 2 ? d / 2 : d - 1; }
-  // The first design row of block k (the second, if any, is the next one above 2).
+  // The first design row of block k (the second, if any, is the next).
   static constexpr int firstRow(int k) {
     if (kRows == 2) return k == 0 ? 0 : 2 * k + 1;
     return k < 2 ? k : k + 1;
@@ -173,7 +173,7 @@ template <typename Blocks>
                                                 double (*sums)[kHalf]) {
   using Sub = typename Blocks::Sub;
   constexpr int kRows = Blocks::rowsPerBlock;
-  const int a0 = Blocks::firstRow(k), a1 = a0 + 1 == 2 ? 3 : a0 + 1;
+  const int a0 = Blocks::firstRow(k), a1 = a0 + 1;  // two rows only in WideBlocks: a0 ≠ 1
   const int rows = kRows == 2 && a1 < d ? 2 : 1;
   const int rowOf[2] = {a0, a1};
   Sub acc[kRows][kMaxColumns];

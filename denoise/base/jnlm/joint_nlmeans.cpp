@@ -59,8 +59,7 @@ float largestFiniteValue(const Image& image) {
 // neighbour. Cross-filtered at few samples, a highlight's pixels looked like the dark pixels beside
 // them to the other half's weights, which then averaged this half's highlight into them.
 Image kneedVariance(Image variance, const Image& guide, double kneeLevel) {
-  const std::vector<float> divisor = kneeDivisors(guide, kneeLevel);
-  for (size_t k = 0; k < variance.size(); ++k) variance.data()[k] /= divisor[k / 3];
+  divideByPixel(variance, kneeDivisors(guide, kneeLevel));
   return variance;
 }
 
@@ -85,8 +84,7 @@ JointNlMeansParams JointNlMeansParams::fromParams(ParamMap& map) {
   require(std::isfinite(p.k) && p.k > 0 && std::isfinite(p.kf) && p.kf > 0, "k and kf must be > 0");
   require(std::isfinite(p.alpha) && p.alpha >= 0, "alpha must be ≥ 0");
   require(std::isfinite(p.tau) && p.tau >= 0, "tau must be ≥ 0");
-  require(std::isfinite(p.varianceKnee) && p.varianceKnee >= 0,
-          "varianceKnee must be 0 (off) or positive");
+  require(validKnee(p.varianceKnee), "varianceKnee must be 0 (off) or positive");
   return p;
 }
 

@@ -38,8 +38,7 @@ NforParams NforParams::fromParams(ParamMap& map) {
   p.distanceClamp = map.getFloat("distanceClamp", p.distanceClamp);
   p.minCenterWeight = map.getFloat("minCenterWeight", p.minCenterWeight);
   p.selectionKnee = map.getFloat("selectionKnee", p.selectionKnee);
-  if (!(p.selectionKnee >= 0) || !std::isfinite(p.selectionKnee))
-    throw Error("nfor: selectionKnee must be 0 (off) or positive");
+  if (!validKnee(p.selectionKnee)) throw Error("nfor: selectionKnee must be 0 (off) or positive");
   for (int v : {p.prefilterF, p.prefilterR, p.regressionF, p.regressionR, p.mseF, p.mseR,
                 p.finalFeatureF, p.finalFeatureR, p.finalF, p.finalR})
     if (v < 0 || v > 32) throw Error("nfor: patch and window radii must be in [0, 32]");

@@ -40,11 +40,7 @@ void selectCandidates(const Image& guide, const Image& variance, const RdfcParam
                              result.candidates[2].sure.data()};
   const Image& narrowest = result.candidates[0].mean;
   kneeBrightErrors(
-      sureMaps, size_t(w) * size_t(h),
-      [&](size_t i) {
-        const float* rgb = narrowest.data() + 3 * i;
-        return (double(rgb[0]) + rgb[1] + rgb[2]) / 3.0;
-      },
+      sureMaps, size_t(w) * size_t(h), [&](size_t i) { return rgbLevel(narrowest, i); },
       kneeLevel({guide.data(), guide.size()}, params.selectionKnee));
   const Image* sure[] = {&result.candidates[0].sure, &result.candidates[1].sure,
                          &result.candidates[2].sure};
@@ -138,7 +134,7 @@ Image rdfcSecondPassVariance(const Image& first1, const Image& first2, const Ima
   Image raw = squaredDifference(first1, first2, 0.25f);
   const std::vector<float> divisor =
       kneeDivisors(guide, kneeLevel({guide.data(), guide.size()}, knee));
-  for (size_t k = 0; k < raw.size(); ++k) raw.data()[k] /= divisor[k / 3];
+  divideByPixel(raw, divisor);
   Image variance = smooth3Tap(raw, std::exp(-2.0f));
   for (size_t k = 0; k < variance.size(); ++k) variance.data()[k] *= divisor[k / 3];
   return variance;
@@ -178,8 +174,7 @@ RdfcParams RdfcParams::fromParams(ParamMap& map) {
                    std::isfinite(c.tauThird) && c.tauThird >= 0 && std::isfinite(p.secondTau) &&
                    p.secondTau >= 0,
                "tau, tauThird, secondTau must be ≥ 0");
-  requireRange(std::isfinite(p.selectionKnee) && p.selectionKnee >= 0 &&
-                   std::isfinite(p.varianceKnee) && p.varianceKnee >= 0,
+  requireRange(validKnee(p.selectionKnee) && validKnee(p.varianceKnee),
                "selectionKnee and varianceKnee must be 0 (off) or positive");
   return p;
 }

@@ -32,6 +32,27 @@ DenoiseInput gaussianHalves(const Image& truth, const Image& sigma, const SubBuf
   return input;
 }
 
+void overstateColorVariances(DenoiseInput& input, float factor) {
+  auto scale = [&](SubBuffer& buffer) {
+    Image& variance = buffer.color.varianceOfMean;
+    for (size_t k = 0; k < variance.size(); ++k) variance.data()[k] *= factor;
+  };
+  scale(input.whole);
+  if (input.halves)
+    for (SubBuffer& half : *input.halves) scale(half);
+}
+
+TruthAndSigma unrepeatedDetail(int width, int height, float amplitude) {
+  TruthAndSigma scene{Image(width, height, 3), Image(width, height, 3)};
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        scene.truth(x, y, c) = 0.5f + amplitude * std::sin(0.001f * float(x * 7919 + y * 104729));
+        scene.sigma(x, y, c) = 0.02f;
+      }
+  return scene;
+}
+
 SubBuffer flatFeatures(int width, int height, float samples) {
   SubBuffer features = SubBuffer::zeros(width, height);
   features.albedo.mean.fill(0.5f);

@@ -15,6 +15,18 @@ namespace chorus::test {
 DenoiseInput gaussianHalves(const Image& truth, const Image& sigma, const SubBuffer& features,
                             uint32_t seed);
 
+// Multiplies the recorded colour variances of the whole and the halves by `factor`: what a
+// stratified sampler's sample variances look like against the noise the means actually carry
+// (variance_calibration.h).
+void overstateColorVariances(DenoiseInput& input, float factor);
+
+// Detail that the features do not show (a white surface whose shading varies from pixel to
+// pixel without repeating): 0.5 ± amplitude per pixel, σ 0.02 for the whole.
+struct TruthAndSigma {
+  Image truth, sigma;
+};
+TruthAndSigma unrepeatedDetail(int width, int height, float amplitude);
+
 // Features of one flat, featureless surface: albedo 0.5, normal +z, depth 2, visibility 1, and
 // `samples` samples per pixel.
 SubBuffer flatFeatures(int width, int height, float samples);

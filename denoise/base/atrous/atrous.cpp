@@ -8,6 +8,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 #include "common/error.h"
@@ -15,6 +16,7 @@
 #include "denoise/base/buffer_variance.h"
 #include "denoise/base/input_planes.h"
 #include "denoise/base/selection_knee.h"
+#include "denoise/base/variance_calibration.h"
 #include "denoise/planes/padded_planes.h"
 
 namespace chorus {
@@ -30,6 +32,7 @@ AtrousParams AtrousParams::fromParams(ParamMap& params) {
   p.symmetricFrom = params.getFloat("symmetricFrom", p.symmetricFrom);
   p.borrow = params.getFloat("borrow", p.borrow);
   p.varianceKnee = params.getFloat("varianceKnee", p.varianceKnee);
+  p.calibrationRadius = params.getInt("calibrate", p.calibrationRadius);
   if (p.iterations < kIterationsFromSamples || p.iterations > kMaxIterations)
     throw Error("atrous: iterations must be in [0, " + std::to_string(kMaxIterations) +
                 "], or -1 (from the samples per pixel)");
@@ -38,6 +41,8 @@ AtrousParams AtrousParams::fromParams(ParamMap& params) {
   if (!(p.symmetricFrom >= 0)) throw Error("atrous: symmetricFrom must be >= 0");
   if (!(p.borrow >= 0 && p.borrow <= 1)) throw Error("atrous: borrow must be in [0, 1]");
   if (!validKnee(p.varianceKnee)) throw Error("atrous: varianceKnee must be 0 (off) or positive");
+  if (p.calibrationRadius < 0 || p.calibrationRadius > kMaxCalibrationRadius)
+    throw Error("atrous: calibrate must be in [0, " + std::to_string(kMaxCalibrationRadius) + "]");
   // Powers of two only: w_n is then a chain of squarings, which vectorises.
   if (p.sigmaN != 0 && !(p.sigmaN >= 1 && p.sigmaN <= 1024 && p.sigmaN == std::floor(p.sigmaN) &&
                          std::has_single_bit(unsigned(p.sigmaN))))
@@ -384,7 +389,7 @@ int iterationsForSamples(double spp) {
 }
 
 Image runAtrous(const SubBuffer& buffer, const AtrousParams& given, AtrousKernelPath path,
-                double sampleShare) {
+                double sampleShare, const Image* calibratedVariance) {
   const int w = buffer.width(), h = buffer.height();
   const double renderSpp = renderSamplesPerPixel(buffer, sampleShare);
   AtrousParams params = given;
@@ -392,7 +397,10 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& given, AtrousKernel
     params.iterations = iterationsForSamples(renderSpp);
   const bool symmetric = renderSpp >= params.symmetricFrom;
   const float* color = buffer.color.mean.data();
-  const float* colorVariance = buffer.color.varianceOfMean.data();
+  const Image& variance = calibratedVariance ? *calibratedVariance : buffer.color.varianceOfMean;
+  if (!variance.sameShape(buffer.color.mean))
+    throw std::invalid_argument("runAtrous: the colour variance's shape differs");
+  const float* colorVariance = variance.data();
   const std::vector<float> divisors = demodulationDivisors(buffer, params.demodulate);
   // Taps reach 2·2^(iterations−1) pixels past the borders: zero margins that wide.
   const int margin = 1 << params.iterations;
@@ -443,6 +451,14 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& given, AtrousKernel
         row[3 * x + c] = finiteOrZero(state.plane(kRed + c)[o + size_t(x)] * d[3 * x + c]);
   });
   return out;
+}
+
+Image Atrous::run(const DenoiseInput& input) const {
+  const Image factor = colorVarianceCalibration(input, params_.calibrationRadius);
+  if (factor.empty())
+    return runAtrous(input.whole, params_, AtrousKernelPath::Widest, input.sampleShare);
+  const Image variance = calibratedVariance(input.whole.color.varianceOfMean, factor);
+  return runAtrous(input.whole, params_, AtrousKernelPath::Widest, input.sampleShare, &variance);
 }
 
 }  // namespace chorus

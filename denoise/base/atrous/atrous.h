@@ -34,6 +34,11 @@
 //     (interior-doorway 16 spp: relMSE 0.48, noisy 0.42; with borrow 0.5: 0.16). Off by default:
 //     better alone and in the preview, but the default ensemble blends worse with it at 4–8 spp
 //     (docs/members/sbf-atrous-bilateral.md);
+//   - optionally (`calibrate` R > 0, with halves in the input), V_c is the recorded variance of
+//     the mean brought to the halves' level over a box of radius R (variance_calibration.h): the
+//     sampler stratifies, so the recorded one overestimates the noise, most where the image is
+//     smooth within a pixel, and the tolerances with it. Off by default: better alone (R 3),
+//     but the default ensemble blends 0.3 % worse with it (docs/variance-calibration.md);
 //   - the 3×3 blur of Var_l takes a bright pixel's variance in relative units (divided by
 //     (l / knee)² where l exceeds `varianceKnee` × the level's mean |luminance|, multiplied back
 //     by p's own): blurred as is, a highlight's variance gave the dark pixels beside it a
@@ -47,6 +52,7 @@ namespace chorus {
 
 struct AtrousParams {
   static constexpr int kMaxIterations = 6;  // the zero margins grow as 2^iterations
+  static constexpr int kMaxCalibrationRadius = 64;
   static constexpr int kIterationsFromSamples = -1;
   // N: à-trous levels, tap spacing 2^i (5 → a 125-pixel footprint); kIterationsFromSamples
   // (default, also `iterations=-1`): iterationsForSamples of the render's samples per pixel.
@@ -64,9 +70,12 @@ struct AtrousParams {
   float borrow = 1.0f;
   // The knee above which the variance blur is relative (0: SVGF's blur everywhere).
   float varianceKnee = 8.0f;
+  // The box radius of the colour variance's calibration to the input's halves (0, default: the
+  // recorded variance as is; inputs without halves keep it too).
+  int calibrationRadius = 0;
 
   // Reads overrides: iterations, sigmaZ, sigmaN, sigmaL, demodulate, clampFireflies,
-  // symmetricFrom, borrow, varianceKnee.
+  // symmetricFrom, borrow, varianceKnee, calibrate (the calibration radius).
   // Throws chorus::Error for a value out of range.
   static AtrousParams fromParams(ParamMap& params);
 };
@@ -83,18 +92,18 @@ int iterationsForSamples(double spp);
 enum class AtrousKernelPath { Widest, Avx2, Sse2, Scalar };
 
 // Runs the filter on one buffer (colour and its variance, albedo, normal, depth) that holds
-// `sampleShare` of the render's samples (DenoiseInput::sampleShare).
+// `sampleShare` of the render's samples (DenoiseInput::sampleShare); with `colorVariance`, that
+// variance of the colour's mean instead of the buffer's.
 Image runAtrous(const SubBuffer& buffer, const AtrousParams& params,
-                AtrousKernelPath path = AtrousKernelPath::Widest, double sampleShare = 1.0);
+                AtrousKernelPath path = AtrousKernelPath::Widest, double sampleShare = 1.0,
+                const Image* colorVariance = nullptr);
 
 class Atrous : public BaseDenoiser {
  public:
   explicit Atrous(AtrousParams params = {}) : params_(params) {}
   std::string name() const override { return "atrous"; }
   DenoiserRequirements requirements() const override { return {.features = true, .halves = false}; }
-  Image run(const DenoiseInput& input) const override {
-    return runAtrous(input.whole, params_, AtrousKernelPath::Widest, input.sampleShare);
-  }
+  Image run(const DenoiseInput& input) const override;
 
  private:
   AtrousParams params_;

@@ -8,6 +8,7 @@
 #include "denoise/base/buffer_variance.h"
 #include "denoise/base/filters/feature_nlmeans.h"
 #include "denoise/base/selection_knee.h"
+#include "denoise/base/variance_calibration.h"
 #include "denoise/base/variance_estimates.h"
 
 namespace chorus {
@@ -79,9 +80,11 @@ JointNlMeansParams JointNlMeansParams::fromParams(ParamMap& map) {
   p.tau = map.getFloat("tau", p.tau);
   p.refineFeatures = map.getBool("refineFeatures", p.refineFeatures);
   p.varianceKnee = map.getFloat("varianceKnee", p.varianceKnee);
+  p.calibrationRadius = map.getInt("calibrate", p.calibrationRadius);
   require(p.r >= 1 && p.r <= 32, "r must be in [1, 32]");
   require(p.f >= 0 && p.f <= 16, "f must be in [0, 16]");
   require(std::isfinite(p.k) && p.k > 0 && std::isfinite(p.kf) && p.kf > 0, "k and kf must be > 0");
+  require(p.calibrationRadius >= 0 && p.calibrationRadius <= 64, "calibrate must be in [0, 64]");
   require(std::isfinite(p.alpha) && p.alpha >= 0, "alpha must be ≥ 0");
   require(std::isfinite(p.tau) && p.tau >= 0, "tau must be ≥ 0");
   require(validKnee(p.varianceKnee), "varianceKnee must be 0 (off) or positive");
@@ -119,8 +122,13 @@ Image runJointNlMeans(const DenoiseInput& input, const JointNlMeansParams& param
     const Image b = finiteOr((*input.halves)[1].color.mean, 0.0f);
     // Each half's own variance of the mean, the smoothed two-buffer estimate where a half holds
     // a single sample.
-    const Image varianceA = kneedVariance(halfVarianceOfMean(input, 0, Quantity::Color), a, knee);
-    const Image varianceB = kneedVariance(halfVarianceOfMean(input, 1, Quantity::Color), b, knee);
+    const Image factor = colorVarianceCalibration(input, params.calibrationRadius);
+    auto halfVariance = [&](int which, const Image& guide) {
+      return kneedVariance(
+          calibratedVariance(halfVarianceOfMean(input, which, Quantity::Color), factor), guide,
+          knee);
+    };
+    const Image varianceA = halfVariance(0, a), varianceB = halfVariance(1, b);
     const Image filteredA = filter(a, b, varianceB);  // A's data, B's colour weights
     const Image filteredB = filter(b, a, varianceA);
     out = meanOf(filteredA, filteredB);

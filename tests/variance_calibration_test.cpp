@@ -92,6 +92,19 @@ TEST(VarianceCalibration, WeighsHalvesOfUnequalCountsWithoutBias) {
   EXPECT_NEAR(mean, 1.0, 0.04);
 }
 
+// Halves without recorded sample counts (another renderer's buffers) count as equal halves.
+TEST(VarianceCalibration, TakesHalvesWithoutCountsAsEqual) {
+  const Level level;
+  DenoiseInput input =
+      test::gaussianHalves(level.truth, level.sigma, test::flatFeatures(kSize, kSize, 64), 9);
+  test::overstateColorVariances(input, 2.0f);
+  for (SubBuffer* buffer : {&input.whole, &(*input.halves)[0], &(*input.halves)[1]})
+    buffer->sampleCount = Image();
+  const Image whole =
+      calibratedVariance(input.whole.color.varianceOfMean, colorVarianceCalibration(input, 3));
+  EXPECT_NEAR(level.ratio(whole, 0, kSize), 1.0, 0.05);
+}
+
 TEST(VarianceCalibration, LeavesTheVarianceAloneWithoutHalvesOrRadius) {
   const Level level;
   DenoiseInput input =

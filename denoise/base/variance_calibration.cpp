@@ -16,10 +16,13 @@ Image colorVarianceCalibration(const DenoiseInput& input, int radius) {
   const int w = input.width(), h = input.height(), channels = own.channels();
   // The two boxes' inputs: the halves' estimate and the recorded variance, both 0 where either
   // is missing, so that the two boxes average over the same pixels.
+  // Without recorded counts the halves are taken to hold equal counts (share ¼).
+  const bool counted = h1.sampleCount.sameSize(own) && h2.sampleCount.sameSize(own);
   Image spread(w, h, channels), recorded(w, h, channels);
   parallelRows(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) {
-      const double n1 = h1.sampleCount(x, y, 0), n2 = h2.sampleCount(x, y, 0);
+      const double n1 = counted ? h1.sampleCount(x, y, 0) : 1.0;
+      const double n2 = counted ? h2.sampleCount(x, y, 0) : 1.0;
       const double share = n1 > 0 && n2 > 0 ? n1 * n2 / ((n1 + n2) * (n1 + n2)) : 0.0;
       for (int c = 0; c < channels; ++c) {
         const double d = double(h1.color.mean(x, y, c)) - double(h2.color.mean(x, y, c));

@@ -4,15 +4,15 @@
 // chorus's sampler stratifies a pixel's samples (Owen-scrambled Sobol, docs/renderer.md), so the
 // sample variance / n that a buffer records overestimates the variance of its mean — the more,
 // the more samples and the smoother the integrand over the pixel: on the evaluation corpus by
-// 1.0–1.1× (lamp) to 1.8–2.4× (flight-helmet-white) at 16–256 spp. Two independent halves'
+// 1.0–1.1× (lamp) to 1.6–2.4× (flight-helmet-white) at 16–256 spp. Two independent halves'
 // squared difference has the right level but is one noisy value per pixel. So, as RDFC does for
 // its own variance (../shared/docs/base-denoisers.md §3), the sample variance keeps its
 // per-pixel structure and takes the halves' level over a box of radius R: per pixel and channel
 // the factor is
 //   Box_R((h1 − h2)² · n1 n2 / (n1 + n2)²) / Box_R(V_whole),
 // where (h1 − h2)² n1 n2 / (n1 + n2)² estimates the variance of the whole's mean for halves of
-// n1 and n2 samples (the held-out inputs' halves hold a quarter and a half). The halves' own
-// variances take the same factor.
+// n1 and n2 samples (the held-out inputs' halves hold a quarter and a half; equal counts where
+// none are recorded). The halves' own variances take the same factor.
 #include "common/image/image.h"
 #include "denoise/buffers/sample_buffers.h"
 

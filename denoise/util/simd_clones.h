@@ -17,3 +17,22 @@
 #define CHORUS_SIMD_CLONES
 #define CHORUS_SIMD_CLONES_EXACT
 #endif
+
+// What the CPU running this supports, for code that picks its own path (explicit kernels, or a
+// blocking that has to match the clone the ifunc resolver picked). Asked once.
+inline bool cpuHasAvx512f() {
+#if defined(__x86_64__) && defined(__GNUC__)
+  static const bool has = __builtin_cpu_supports("avx512f");
+  return has;
+#else
+  return false;
+#endif
+}
+inline bool cpuHasAvx2() {
+#if defined(__x86_64__) && defined(__GNUC__)
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+#else
+  return false;
+#endif
+}

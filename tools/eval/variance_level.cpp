@@ -14,10 +14,37 @@
 #include "common/image/exr_io.h"
 #include "denoise/base/variance_calibration.h"
 #include "denoise/buffers/buffers_exr.h"
+#include "denoise/metrics/metrics.h"
 #include "tools/eval/tool_main.h"
 
 namespace chorus {
 namespace {
+
+// A variance image averaged as relMSE averages squared errors: each value over (reference² + ε).
+double relativeMean(const Image& variance, const Image& reference) {
+  double sum = 0;
+  for (size_t k = 0; k < variance.size(); ++k) {
+    const double r = reference.data()[k];
+    sum += variance.data()[k] / (r * r + kRelMseEpsilon);
+  }
+  return sum / double(variance.size());
+}
+
+// The variance of the mean of the K sub-buffers' means, from their spread (unbiased for
+// independent sub-buffers).
+Image subBufferSpread(const SampleBuffers& buffers) {
+  const int K = buffers.splitCount();
+  const Image& first = buffers.sub(0).color.mean;
+  Image spread(first.width(), first.height(), first.channels());
+  for (size_t e = 0; e < spread.size(); ++e) {
+    double mean = 0, squares = 0;
+    for (int k = 0; k < K; ++k) mean += buffers.sub(k).color.mean.data()[e];
+    mean /= K;
+    for (int k = 0; k < K; ++k) squares += std::pow(buffers.sub(k).color.mean.data()[e] - mean, 2);
+    spread.data()[e] = float(squares / (K - 1) / K);
+  }
+  return spread;
+}
 
 void run(const std::string& renderPath, const std::string& referencePath, int radius) {
   const SampleBuffers buffers = sampleBuffersFromLayers(readExr(renderPath), renderPath);
@@ -27,30 +54,17 @@ void run(const std::string& renderPath, const std::string& referencePath, int ra
   const DenoiseInput full = buffers.input(BufferPart::Full);
   if (!reference.sameShape(full.whole.color.mean))
     throw Error(referencePath + ": its size differs from the render's");
-  const Image calibrated =
-      calibratedVariance(full.whole.color.varianceOfMean, colorVarianceCalibration(full, radius));
-  double error = 0, recorded = 0, spread = 0, calibratedSum = 0;
-  long n = 0;
-  for (int y = 0; y < reference.height(); ++y)
-    for (int x = 0; x < reference.width(); ++x)
-      for (int c = 0; c < 3; ++c, ++n) {
-        const double r = reference(x, y, c), weight = 1.0 / (r * r + 0.01);
-        const double e = full.whole.color.mean(x, y, c) - r;
-        error += weight * e * e;
-        recorded += weight * full.whole.color.varianceOfMean(x, y, c);
-        calibratedSum += weight * calibrated(x, y, c);
-        double mean = 0, squares = 0;
-        for (int k = 0; k < K; ++k) mean += buffers.sub(k).color.mean(x, y, c);
-        mean /= K;
-        for (int k = 0; k < K; ++k)
-          squares += std::pow(buffers.sub(k).color.mean(x, y, c) - mean, 2);
-        spread += weight * squares / (K - 1) / K;  // the variance of the mean of K means
-      }
+  const Image& recordedVariance = full.whole.color.varianceOfMean;
+  const double error = relMse(full.whole.color.mean, reference);
+  const double recorded = relativeMean(recordedVariance, reference);
+  const double spread = relativeMean(subBufferSpread(buffers), reference);
+  const double calibrated = relativeMean(
+      calibratedVariance(recordedVariance, colorVarianceCalibration(full, radius)), reference);
   std::printf(
       "%s: K %d, error %.4g; recorded variance %.4g (%.2fx the error), sub-buffer spread "
       "%.4g (%.2fx), calibrated %.4g (%.2fx)\n",
-      renderPath.c_str(), K, error / n, recorded / n, recorded / error, spread / n, spread / error,
-      calibratedSum / n, calibratedSum / error);
+      renderPath.c_str(), K, error, recorded, recorded / error, spread, spread / error, calibrated,
+      calibrated / error);
 }
 
 }  // namespace

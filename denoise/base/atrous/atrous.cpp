@@ -18,6 +18,7 @@
 #include "denoise/base/selection_knee.h"
 #include "denoise/base/variance_calibration.h"
 #include "denoise/planes/padded_planes.h"
+#include "denoise/util/simd_clones.h"
 
 namespace chorus {
 
@@ -162,11 +163,9 @@ void clampFireflies(PaddedPlanes& state) {
 // The row filter for a kernel path: AVX2 where requested and available, else SSE2 (or scalar).
 AtrousRowFilter atrousRowFilter(AtrousKernelPath path, int squarings, bool unknownNormals) {
 #if defined(__x86_64__) && defined(__GNUC__)
-  static const bool avx512 = __builtin_cpu_supports("avx512f");
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (avx512 && path == AtrousKernelPath::Widest)
+  if (cpuHasAvx512f() && path == AtrousKernelPath::Widest)
     if (AtrousRowFilter f = selectAtrousRowFilterAvx512(squarings, unknownNormals)) return f;
-  if (avx2 && (path == AtrousKernelPath::Widest || path == AtrousKernelPath::Avx2))
+  if (cpuHasAvx2() && (path == AtrousKernelPath::Widest || path == AtrousKernelPath::Avx2))
     if (AtrousRowFilter f = selectAtrousRowFilterAvx2(squarings, unknownNormals)) return f;
 #endif
 #if defined(__SSE2__)
@@ -389,7 +388,7 @@ int iterationsForSamples(double spp) {
 }
 
 Image runAtrous(const SubBuffer& buffer, const AtrousParams& given, AtrousKernelPath path,
-                double sampleShare, const Image* calibratedVariance) {
+                double sampleShare, const Image* colorVariance) {
   const int w = buffer.width(), h = buffer.height();
   const double renderSpp = renderSamplesPerPixel(buffer, sampleShare);
   AtrousParams params = given;
@@ -397,10 +396,9 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& given, AtrousKernel
     params.iterations = iterationsForSamples(renderSpp);
   const bool symmetric = renderSpp >= params.symmetricFrom;
   const float* color = buffer.color.mean.data();
-  const Image& variance = calibratedVariance ? *calibratedVariance : buffer.color.varianceOfMean;
+  const Image& variance = colorVariance ? *colorVariance : buffer.color.varianceOfMean;
   if (!variance.sameShape(buffer.color.mean))
     throw std::invalid_argument("runAtrous: the colour variance's shape differs");
-  const float* colorVariance = variance.data();
   const std::vector<float> divisors = demodulationDivisors(buffer, params.demodulate);
   // Taps reach 2·2^(iterations−1) pixels past the borders: zero margins that wide.
   const int margin = 1 << params.iterations;
@@ -408,7 +406,7 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& given, AtrousKernel
   PaddedPlanes state(w, h, kStatePlanes, margin);
   tbb::parallel_for(0, h, [&](int y) {
     const size_t first = size_t(y) * size_t(w) * 3, o = state.index(0, y);
-    const float *m = color + first, *v = colorVariance + first, *d = divisors.data() + first;
+    const float *m = color + first, *v = variance.data() + first, *d = divisors.data() + first;
     float* rgb[3] = {state.plane(kRed) + o, state.plane(kGreen) + o, state.plane(kBlue) + o};
     float* variance = state.plane(kVariance) + o;
     for (int x = 0; x < w; ++x) {

@@ -395,22 +395,12 @@ struct ThreadState {
   std::vector<uint8_t> skip;        // per offset: every weight of the group is 0
 };
 
-// AVX-512F: 32 vector registers of 8 doubles (WideBlocks); otherwise NarrowBlocks.
-bool cpuHasWideVectors() {
-#if defined(__x86_64__) && defined(__GNUC__)
-  static const bool wide = __builtin_cpu_supports("avx512f");
-  return wide;
-#else
-  return false;
-#endif
-}
-
 class Regression {
  public:
   Regression(const Image& image, const Image& features, const NlMeansWeights& weights,
              std::span<const int> powers, const GramTolerances& tol, GramSumBlocking blocking)
       : wide_(blocking == GramSumBlocking::Wide ||
-              (blocking == GramSumBlocking::ForThisCpu && cpuHasWideVectors())),
+              (blocking == GramSumBlocking::ForThisCpu && cpuHasAvx512f())),
         weights_(weights),
         powers_(powers.begin(), powers.end()),
         tol_(tol),
@@ -561,7 +551,7 @@ class Regression {
     return result;
   }
 
-  bool wide_;  // WideBlocks (AVX-512) or NarrowBlocks
+  bool wide_;  // WideBlocks (AVX-512F: 32 registers of 8 doubles) or NarrowBlocks
   const NlMeansWeights& weights_;
   std::vector<int> powers_;
   GramTolerances tol_;

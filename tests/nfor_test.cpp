@@ -35,8 +35,8 @@ TEST(Nfor, SingleSampleHalvesFallBackToTheTwoBufferVariance) {
   const DenoiseInput input = scene.buffers.input(BufferPart::HalfA);
   ASSERT_EQ(input.halves->at(0).sampleCount(3, 3, 0), 1.0f);
   const Image v = halfVarianceOfMean(input, 0, Quantity::Color);
-  const Image expected =
-      twoBufferVariance(input.halves->at(0).color.mean, input.halves->at(1).color.mean, 0.5f);
+  const Image expected = twoBufferVariance(input.halves->at(0), input.halves->at(1),
+                                           Quantity::Color, TwoBufferTarget::FirstHalf);
   int positive = 0;
   for (size_t i = 0; i < v.size(); ++i) {
     ASSERT_TRUE(std::isfinite(v.data()[i]));

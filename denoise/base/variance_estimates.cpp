@@ -29,12 +29,28 @@ const std::array<SubBuffer, 2>& halvesOf(const DenoiseInput& input) {
 
 }  // namespace
 
-Image twoBufferVariance(const Image& x1, const Image& x2, float scale) {
-  Image sq(x1.width(), x1.height(), x1.channels());
-  for (size_t i = 0; i < sq.size(); ++i) {
-    const float d = x1.data()[i] - x2.data()[i];
-    sq.data()[i] = std::isfinite(d) ? d * d * scale : 0.0f;
-  }
+Image twoBufferVariance(const SubBuffer& h1, const SubBuffer& h2, Quantity q,
+                        TwoBufferTarget target) {
+  const Image& x1 = h1.get(q).mean;
+  const Image& x2 = h2.get(q).mean;
+  const bool counted = h1.sampleCount.sameSize(x1) && h2.sampleCount.sameSize(x1);
+  const int channels = x1.channels();
+  Image sq(x1.width(), x1.height(), channels);
+  for (int y = 0; y < sq.height(); ++y)
+    for (int x = 0; x < sq.width(); ++x) {
+      // Equal counts where none are recorded, and where a half has no sample (a 1-spp render):
+      // the estimate is then as rough as before counts were taken into account, not 0.
+      const bool known = counted && h1.sampleCount(x, y, 0) > 0 && h2.sampleCount(x, y, 0) > 0;
+      const double n1 = known ? h1.sampleCount(x, y, 0) : 1.0;
+      const double n2 = known ? h2.sampleCount(x, y, 0) : 1.0;
+      const double share = target == TwoBufferTarget::Whole ? n1 * n2 / ((n1 + n2) * (n1 + n2))
+                           : target == TwoBufferTarget::FirstHalf ? n2 / (n1 + n2)
+                                                                  : n1 / (n1 + n2);
+      for (int c = 0; c < channels; ++c) {
+        const float d = x1(x, y, c) - x2(x, y, c);
+        sq(x, y, c) = std::isfinite(d) ? float(double(d) * double(d) * share) : 0.0f;
+      }
+    }
   return boxFilter(sq, kVarianceFallbackRadius);
 }
 
@@ -43,14 +59,16 @@ Image wholeVarianceOfMean(const DenoiseInput& input, Quantity q) {
   if (!input.halves) return whole.varianceOfMean;
   const auto& halves = halvesOf(input);
   return withFallback(whole.varianceOfMean, input.whole.sampleCount,
-                      twoBufferVariance(halves[0].get(q).mean, halves[1].get(q).mean, 0.25f));
+                      twoBufferVariance(halves[0], halves[1], q, TwoBufferTarget::Whole));
 }
 
 Image halfVarianceOfMean(const DenoiseInput& input, int which, Quantity q) {
   const auto& halves = halvesOf(input);
   const SubBuffer& half = halves.at(size_t(which));
+  const TwoBufferTarget target =
+      which == 0 ? TwoBufferTarget::FirstHalf : TwoBufferTarget::SecondHalf;
   return withFallback(half.get(q).varianceOfMean, half.sampleCount,
-                      twoBufferVariance(halves[0].get(q).mean, halves[1].get(q).mean, 0.5f));
+                      twoBufferVariance(halves[0], halves[1], q, target));
 }
 
 }  // namespace chorus

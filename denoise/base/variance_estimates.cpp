@@ -38,8 +38,8 @@ Image twoBufferVariance(const SubBuffer& h1, const SubBuffer& h2, Quantity q,
   Image sq(x1.width(), x1.height(), channels);
   for (int y = 0; y < sq.height(); ++y)
     for (int x = 0; x < sq.width(); ++x) {
-      // Equal counts where none are recorded, and where a half has no sample (a 1-spp render):
-      // the estimate is then as rough as before counts were taken into account, not 0.
+      // Equal counts where none are recorded, and where a half has no sample (a 1-spp render:
+      // a rough estimate from the one mean there is still better than a variance of 0).
       const bool known = counted && h1.sampleCount(x, y, 0) > 0 && h2.sampleCount(x, y, 0) > 0;
       const double n1 = known ? h1.sampleCount(x, y, 0) : 1.0;
       const double n2 = known ? h2.sampleCount(x, y, 0) : 1.0;

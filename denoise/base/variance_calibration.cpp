@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "denoise/base/filters/box_filter.h"
+#include "denoise/base/variance_estimates.h"
 #include "denoise/util/parallel_rows.h"
 
 namespace chorus {
@@ -23,7 +24,7 @@ Image colorVarianceCalibration(const DenoiseInput& input, int radius) {
     for (int x = 0; x < w; ++x) {
       const double n1 = counted ? h1.sampleCount(x, y, 0) : 1.0;
       const double n2 = counted ? h2.sampleCount(x, y, 0) : 1.0;
-      const double share = n1 > 0 && n2 > 0 ? n1 * n2 / ((n1 + n2) * (n1 + n2)) : 0.0;
+      const double share = n1 > 0 && n2 > 0 ? twoBufferShare(n1, n2, TwoBufferTarget::Whole) : 0.0;
       for (int c = 0; c < channels; ++c) {
         const double d = double(h1.color.mean(x, y, c)) - double(h2.color.mean(x, y, c));
         const float estimate = float(d * d * share), v = own(x, y, c);

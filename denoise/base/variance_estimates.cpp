@@ -29,6 +29,18 @@ const std::array<SubBuffer, 2>& halvesOf(const DenoiseInput& input) {
 
 }  // namespace
 
+double twoBufferShare(double n1, double n2, TwoBufferTarget target) {
+  switch (target) {
+    case TwoBufferTarget::Whole:
+      return n1 * n2 / ((n1 + n2) * (n1 + n2));
+    case TwoBufferTarget::FirstHalf:
+      return n2 / (n1 + n2);
+    case TwoBufferTarget::SecondHalf:
+      return n1 / (n1 + n2);
+  }
+  return 0.0;
+}
+
 Image twoBufferVariance(const SubBuffer& h1, const SubBuffer& h2, Quantity q,
                         TwoBufferTarget target) {
   const Image& x1 = h1.get(q).mean;
@@ -43,9 +55,7 @@ Image twoBufferVariance(const SubBuffer& h1, const SubBuffer& h2, Quantity q,
       const bool known = counted && h1.sampleCount(x, y, 0) > 0 && h2.sampleCount(x, y, 0) > 0;
       const double n1 = known ? h1.sampleCount(x, y, 0) : 1.0;
       const double n2 = known ? h2.sampleCount(x, y, 0) : 1.0;
-      const double share = target == TwoBufferTarget::Whole ? n1 * n2 / ((n1 + n2) * (n1 + n2))
-                           : target == TwoBufferTarget::FirstHalf ? n2 / (n1 + n2)
-                                                                  : n1 / (n1 + n2);
+      const double share = twoBufferShare(n1, n2, target);
       for (int c = 0; c < channels; ++c) {
         const float d = x1(x, y, c) - x2(x, y, c);
         sq(x, y, c) = std::isfinite(d) ? float(double(d) * double(d) * share) : 0.0f;

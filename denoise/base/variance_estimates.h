@@ -21,7 +21,11 @@ inline constexpr int kVarianceFallbackRadius = 2;
 // Which variance of the mean the two-buffer estimate is for.
 enum class TwoBufferTarget { Whole, FirstHalf, SecondHalf };
 
-// The two-buffer estimate (X1 − X2)² × the target's share of the counts (above), box-smoothed;
+// The factor of (X1 − X2)² whose expectation is the target's variance of the mean, for halves of
+// n1, n2 > 0 samples (above).
+double twoBufferShare(double n1, double n2, TwoBufferTarget target);
+
+// The two-buffer estimate (X1 − X2)² × twoBufferShare, box-smoothed;
 // finite wherever X1, X2 are. Equal counts where the halves have none recorded.
 Image twoBufferVariance(const SubBuffer& h1, const SubBuffer& h2, Quantity q,
                         TwoBufferTarget target);

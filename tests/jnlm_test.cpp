@@ -43,15 +43,12 @@ TEST(JointNlMeans, KeepsASmallHighlightOffTheWallAroundIt) {
 // and average it away (1.64× the noisy input's relMSE, Rousselle's k 0.45: 1.47×). Calibrated
 // to the halves, it must keep the detail and still remove noise.
 TEST(JointNlMeans, KeepsDetailItsStratifiedSamplesResolve) {
-  const test::TruthAndSigma scene = test::unrepeatedDetail(64, 64, 0.04f);
-  DenoiseInput input =
-      test::gaussianHalves(scene.truth, scene.sigma, test::flatFeatures(64, 64, 64.0f), 1);
-  test::overstateColorVariances(input, 2.5f);
-  const double noisy = relMse(input.whole.color.mean, scene.truth);
+  const test::OverstatedDetail d = test::overstatedDetail(64, 64.0f, 2.5f, 1);
+  const double noisy = relMse(d.input.whole.color.mean, d.scene.truth);
   JointNlMeansParams uncalibrated;
   uncalibrated.calibrationRadius = 0;
-  EXPECT_LT(relMse(runJointNlMeans(input, JointNlMeansParams{}), scene.truth), 0.5 * noisy);
-  EXPECT_GT(relMse(runJointNlMeans(input, uncalibrated), scene.truth), noisy);
+  EXPECT_LT(relMse(runJointNlMeans(d.input, JointNlMeansParams{}), d.scene.truth), 0.5 * noisy);
+  EXPECT_GT(relMse(runJointNlMeans(d.input, uncalibrated), d.scene.truth), noisy);
 }
 
 TEST(JointNlMeans, ReducesRelMseOnTheSyntheticScene) {

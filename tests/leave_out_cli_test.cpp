@@ -111,6 +111,25 @@ TEST(LeaveOutCli, ARenderForMembersThatReadFewerFeaturesRecordsOnlyThose) {
 
 // By default a render writes what a user looks at and render.exr; --keep adds exactly the files
 // it lists, and stats.json lists what was written and what was left out.
+// A member that calibrates its colour variance to the halves (calibrate=R) reads them although
+// it does not need them: a render for it keeps the full buffer's halves. It did not (a render
+// with atrous:calibrate=3 wrote the bits of plain atrous: the option did nothing there).
+TEST(LeaveOutCli, MembersThatCalibrateGetTheHalves) {
+  TempDir dir;
+  for (const std::string member : {"atrous", "sbf"}) {
+    auto denoised = [&](const std::string& spec) {
+      const fs::path out = dir / spec;
+      const auto r = runChorus({"render", cornellBox(), "--width", "24", "--spp", "32", "--denoise",
+                                spec, "--quiet", "--out", out.string()});
+      EXPECT_EQ(r.exitCode, 0) << r.err;
+      return readRgbExr(out / "denoised.exr");
+    };
+    const Image plain = denoised(member), off = denoised(member + ":calibrate=0");
+    EXPECT_TRUE(sameBits(plain, off)) << member;  // calibrate=0 is the default
+    EXPECT_FALSE(sameBits(plain, denoised(member + ":calibrate=3"))) << member;
+  }
+}
+
 TEST(LeaveOutCli, RenderWritesMemberAndWeightFilesOnlyWithKeep) {
   TempDir dir;
   const std::vector<std::string> base = {"render", cornellBox(), "--width",   "12",

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -103,6 +104,30 @@ TEST(VarianceCalibration, TakesHalvesWithoutCountsAsEqual) {
   const Image whole =
       calibratedVariance(input.whole.color.varianceOfMean, colorVarianceCalibration(input, 3));
   EXPECT_NEAR(level.ratio(whole, 0, kSize), 1.0, 0.05);
+}
+
+// Capped at 1 (SBF's use) the factor only lowers a variance: an understated one (0.4× the
+// noise) stays as recorded, an overstated one (2.5×) comes down as without the cap.
+TEST(VarianceCalibration, CappedFactorOnlyLowersTheVariance) {
+  const Level level;
+  for (float stated : {0.4f, 2.5f}) {
+    DenoiseInput input =
+        test::gaussianHalves(level.truth, level.sigma, test::flatFeatures(kSize, kSize, 64), 13);
+    test::overstateColorVariances(input, stated);
+    const Image capped = colorVarianceCalibration(input, 3, 1.0f);
+    const Image free = colorVarianceCalibration(input, 3);
+    ASSERT_FALSE(capped.empty());
+    double mean = 0;
+    for (size_t k = 0; k < capped.size(); ++k) {
+      ASSERT_LE(capped.data()[k], 1.0f);
+      ASSERT_EQ(capped.data()[k], std::min(free.data()[k], 1.0f));
+      mean += capped.data()[k] / double(capped.size());
+    }
+    if (stated < 1.0f)
+      EXPECT_GT(mean, 0.97) << "an understated variance stays as recorded";
+    else
+      EXPECT_NEAR(mean, 1.0 / stated, 0.05);
+  }
 }
 
 TEST(VarianceCalibration, LeavesTheVarianceAloneWithoutHalvesOrRadius) {

@@ -1,5 +1,6 @@
 #include "denoise/base/variance_calibration.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -9,7 +10,7 @@
 
 namespace chorus {
 
-Image colorVarianceCalibration(const DenoiseInput& input, int radius) {
+Image colorVarianceCalibration(const DenoiseInput& input, int radius, float maxFactor) {
   if (radius <= 0 || !input.halves) return {};
   const SubBuffer& h1 = (*input.halves)[0];
   const SubBuffer& h2 = (*input.halves)[1];
@@ -39,7 +40,8 @@ Image colorVarianceCalibration(const DenoiseInput& input, int radius) {
   parallelChunks(factor.size(), [&](size_t begin, size_t end) {
     for (size_t k = begin; k < end; ++k) {
       const float f = spreadBox.data()[k] / recordedBox.data()[k];
-      factor.data()[k] = recordedBox.data()[k] > 0.0f && std::isfinite(f) ? f : 1.0f;
+      factor.data()[k] =
+          std::min(recordedBox.data()[k] > 0.0f && std::isfinite(f) ? f : 1.0f, maxFactor);
     }
   });
   return factor;

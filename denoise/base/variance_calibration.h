@@ -13,16 +13,24 @@
 // where (h1 − h2)² n1 n2 / (n1 + n2)² estimates the variance of the whole's mean for halves of
 // n1 and n2 samples (the held-out inputs' halves hold a quarter and a half; equal counts where
 // none are recorded). The halves' own variances take the same factor.
+#include <limits>
+
 #include "common/image/image.h"
 #include "denoise/buffers/sample_buffers.h"
 
 namespace chorus {
 
-// The factor (3 channels, finite, ≥ 0) for the colour variances of `input`; an empty image
-// when the input has no halves or radius is 0 (nothing to calibrate against: keep the
-// variances). Pixels whose means or variance are not finite count as missing in both boxes; a
-// box without any sample variance gets the factor 1.
-Image colorVarianceCalibration(const DenoiseInput& input, int radius);
+// The largest box radius a member's calibrate=R option accepts.
+inline constexpr int kMaxCalibrationRadius = 64;
+
+// The factor (3 channels, finite, in [0, maxFactor]) for the colour variances of `input`; an
+// empty image when the input has no halves or radius is 0 (nothing to calibrate against: keep
+// the variances). Pixels whose means or variance are not finite count as missing in both boxes;
+// a box without any sample variance gets the factor min(1, maxFactor). maxFactor 1 lets the
+// calibration only lower the variance (stratification can only lower the variance of a mean;
+// a box whose halves differ by more than the recorded variance says is then taken as noise).
+Image colorVarianceCalibration(const DenoiseInput& input, int radius,
+                               float maxFactor = std::numeric_limits<float>::infinity());
 
 // variance × factor per element (variance itself when factor is empty). Same shape required.
 Image calibratedVariance(const Image& variance, const Image& factor);

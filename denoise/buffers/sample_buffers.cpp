@@ -254,4 +254,8 @@ double meanSampleCount(const SubBuffer& buffer) {
   return total / double(counts.size());
 }
 
+double renderSamplesPerPixel(const SubBuffer& buffer, double sampleShare) {
+  return sampleShare > 0 ? meanSampleCount(buffer) / sampleShare : 0.0;
+}
+
 }  // namespace chorus

@@ -105,6 +105,10 @@ struct DenoiseInput {
   int height() const { return whole.height(); }
 };
 
+// The mean sample count of the render a buffer comes from, given the share of the render's
+// samples it holds (DenoiseInput::sampleShare); 0 without counts.
+double renderSamplesPerPixel(const SubBuffer& buffer, double sampleShare);
+
 // Which part of a SampleBuffers an ensemble run denoises.
 enum class BufferPart { HalfA, HalfB, Full };
 std::string_view partName(BufferPart part);  // "A", "B", "full"

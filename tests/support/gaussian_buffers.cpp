@@ -53,6 +53,13 @@ TruthAndSigma unrepeatedDetail(int width, int height, float amplitude) {
   return scene;
 }
 
+OverstatedDetail overstatedDetail(int size, float samples, float factor, uint32_t seed) {
+  OverstatedDetail d{unrepeatedDetail(size, size, 0.04f), {}};
+  d.input = gaussianHalves(d.scene.truth, d.scene.sigma, flatFeatures(size, size, samples), seed);
+  overstateColorVariances(d.input, factor);
+  return d;
+}
+
 SubBuffer flatFeatures(int width, int height, float samples) {
   SubBuffer features = SubBuffer::zeros(width, height);
   features.albedo.mean.fill(0.5f);

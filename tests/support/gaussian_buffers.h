@@ -27,6 +27,15 @@ struct TruthAndSigma {
 };
 TruthAndSigma unrepeatedDetail(int width, int height, float amplitude);
 
+// unrepeatedDetail (amplitude 0.04: ±2σ) through gaussianHalves on flatFeatures with `samples`
+// per pixel, the recorded colour variances overstated `factor` times: stratified samples at a
+// high count against the members that believe their recorded variance.
+struct OverstatedDetail {
+  TruthAndSigma scene;
+  DenoiseInput input;
+};
+OverstatedDetail overstatedDetail(int size, float samples, float factor, uint32_t seed);
+
 // Features of one flat, featureless surface: albedo 0.5, normal +z, depth 2, visibility 1, and
 // `samples` samples per pixel.
 SubBuffer flatFeatures(int width, int height, float samples);

@@ -53,11 +53,6 @@ AtrousParams AtrousParams::fromParams(ParamMap& params) {
 
 namespace {
 
-// The mean sample count of the render this buffer comes from (0 without counts).
-double renderSamplesPerPixel(const SubBuffer& buffer, double sampleShare) {
-  return sampleShare > 0 ? meanSampleCount(buffer) / sampleShare : 0.0;
-}
-
 constexpr std::array<float, 3> kLuminance = {0.2126f, 0.7152f, 0.0722f};
 constexpr float kLuminanceEpsilon = 1e-10f;  // SVGF
 constexpr float kAlbedoFloor = 1e-3f;        // demodulation

@@ -52,7 +52,6 @@ namespace chorus {
 
 struct AtrousParams {
   static constexpr int kMaxIterations = 6;  // the zero margins grow as 2^iterations
-  static constexpr int kMaxCalibrationRadius = 64;
   static constexpr int kIterationsFromSamples = -1;
   // N: à-trous levels, tap spacing 2^i (5 → a 125-pixel footprint); kIterationsFromSamples
   // (default, also `iterations=-1`): iterationsForSamples of the render's samples per pixel.
@@ -102,7 +101,10 @@ class Atrous : public BaseDenoiser {
  public:
   explicit Atrous(AtrousParams params = {}) : params_(params) {}
   std::string name() const override { return "atrous"; }
-  DenoiserRequirements requirements() const override { return {.features = true, .halves = false}; }
+  // The calibration (calibrate=R) compares the halves when the input has them.
+  DenoiserRequirements requirements() const override {
+    return {.features = true, .halves = false, .readsHalves = params_.calibrationRadius > 0};
+  }
   Image run(const DenoiseInput& input) const override;
 
  private:

@@ -12,6 +12,7 @@
 #include "denoise/base/filters/sure.h"
 #include "denoise/base/input_planes.h"
 #include "denoise/base/selection_knee.h"
+#include "denoise/base/variance_calibration.h"
 
 namespace chorus {
 
@@ -64,6 +65,11 @@ SbfParams SbfParams::fromParams(ParamMap& params) {
   requirePositive(p.sigmaD, "sigmaD");
   if (!(p.sigmaMse >= 0)) throw Error("sbf: sigmaMse must be 0 (from the samples) or positive");
   if (p.sigmaMse > 64) throw Error("sbf: sigmaMse must be ≤ 64");
+  p.calibrationRadius = params.getInt("calibrate", p.calibrationRadius);
+  if (p.calibrationRadius < 0 || p.calibrationRadius > kMaxCalibrationRadius)
+    throw Error("sbf: calibrate must be in [0, " + std::to_string(kMaxCalibrationRadius) + "]");
+  p.calibrateFrom = params.getFloat("calibrateFrom", p.calibrateFrom);
+  requirePositive(p.calibrateFrom, "calibrateFrom");
   return p;
 }
 
@@ -72,12 +78,14 @@ float sureSmoothingWidth(double spp) {
   return float(std::clamp(16.0 / std::sqrt(spp), 2.0, 8.0));
 }
 
-SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params) {
+SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params,
+                 const Image* calibratedVariance) {
   const int w = buffer.width(), h = buffer.height();
   const size_t pixels = size_t(w) * size_t(h);
   const int candidateCount = int(params.sigmaS.size());
   const PlanarImage color = sanitizedMean(buffer.color);
-  const PlanarImage variance = sanitizedVarianceOfMean(buffer.color);
+  const PlanarImage variance = sanitizedVarianceOfMean(
+      calibratedVariance ? MeanVariance{buffer.color.mean, *calibratedVariance} : buffer.color);
   const FeatureGuide guide =
       makeFeatureGuide(buffer, {params.sigmaN, params.sigmaR, params.sigmaD});
 
@@ -116,7 +124,8 @@ SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params) {
       },
       kneeLevel({color.plane(0), size_t(3) * pixels}, params.selectionKnee));
   const float sigmaMse =
-      params.sigmaMse > 0 ? params.sigmaMse : sureSmoothingWidth(meanSampleCount(buffer));
+      (params.sigmaMse > 0 ? params.sigmaMse : sureSmoothingWidth(meanSampleCount(buffer))) *
+      (calibratedVariance ? kCalibratedSureSmoothing : 1.0f);
   const PlanarImage smoothed = crossBilateralSmooth(sure, guide, sigmaMse);
 
   // 4. Hard per-pixel selection; ties go to the first candidate in sigmaS order.
@@ -135,6 +144,17 @@ SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params) {
                       }
                     });
   return result;
+}
+
+Image Sbf::run(const DenoiseInput& input) const {
+  const bool calibrate =
+      params_.calibrationRadius > 0 &&
+      renderSamplesPerPixel(input.whole, input.sampleShare) >= params_.calibrateFrom;
+  const Image factor =
+      calibrate ? colorVarianceCalibration(input, params_.calibrationRadius, 1.0f) : Image();
+  if (factor.empty()) return runSbf(input.whole, params_).output;
+  const Image variance = calibratedVariance(input.whole.color.varianceOfMean, factor);
+  return runSbf(input.whole, params_, &variance).output;
 }
 
 }  // namespace chorus

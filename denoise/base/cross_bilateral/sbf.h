@@ -30,9 +30,19 @@ struct SbfParams {
   // Not the release's: pixels brighter than this times the image's mean |colour| enter step 3
   // with their SURE in relative units (denoise/base/selection_knee.h); 0 = the release's.
   float selectionKnee = 16.0f;
+  // Not the release's, off by default: from `calibrateFrom` samples per pixel of the render on,
+  // SURE takes the colour variance calibrated to the halves over a box of this radius, capped
+  // at 1 (variance_calibration.h: the recorded variance overstates the noise of stratified
+  // samples, up to 2.4× at 256 spp, and SURE then prefers wide candidates that blur what the
+  // samples resolve), and smooths its maps kCalibratedSureSmoothing times wider (the calibrated
+  // SURE is noisier). calibrate=3 makes SBF alone better from 16 spp on, on both halves of the
+  // corpus, but the ensembles with it blend worse on the tuning half
+  // (docs/members/sbf-atrous-bilateral.md); 0 = the recorded variance.
+  int calibrationRadius = 0;
+  float calibrateFrom = 16.0f;
 
   // Reads overrides: sigmaS=0/1/2/4/8 (slash-separated), sigmaN, sigmaR, sigmaD, sigmaMse,
-  // selectionKnee.
+  // selectionKnee, calibrate (the radius), calibrateFrom.
   // Throws chorus::Error for a value out of range.
   static SbfParams fromParams(ParamMap& params);
 };
@@ -50,17 +60,24 @@ struct SbfResult {
 // (docs/members/sbf-atrous-bilateral.md).
 float sureSmoothingWidth(double spp);
 
-// Runs SBF on one buffer (colour, its variance of the mean, normal, albedo, depth, sample count).
-SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params);
+// How much wider the SURE maps are smoothed when SURE takes the calibrated variance.
+inline constexpr float kCalibratedSureSmoothing = 1.5f;
+
+// Runs SBF on one buffer (colour, its variance of the mean, normal, albedo, depth, sample count);
+// with `calibratedVariance`, SURE takes that variance of the colour's mean instead of the
+// buffer's and smooths its maps kCalibratedSureSmoothing times wider.
+SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params,
+                 const Image* calibratedVariance = nullptr);
 
 class Sbf : public BaseDenoiser {
  public:
   explicit Sbf(SbfParams params = {}) : params_(std::move(params)) {}
   std::string name() const override { return "sbf"; }
-  DenoiserRequirements requirements() const override { return {.features = true, .halves = false}; }
-  Image run(const DenoiseInput& input) const override {
-    return runSbf(input.whole, params_).output;
+  // The calibration compares the halves when the input has them.
+  DenoiserRequirements requirements() const override {
+    return {.features = true, .halves = false, .readsHalves = params_.calibrationRadius > 0};
   }
+  Image run(const DenoiseInput& input) const override;
 
  private:
   SbfParams params_;

@@ -84,7 +84,8 @@ JointNlMeansParams JointNlMeansParams::fromParams(ParamMap& map) {
   require(p.r >= 1 && p.r <= 32, "r must be in [1, 32]");
   require(p.f >= 0 && p.f <= 16, "f must be in [0, 16]");
   require(std::isfinite(p.k) && p.k > 0 && std::isfinite(p.kf) && p.kf > 0, "k and kf must be > 0");
-  require(p.calibrationRadius >= 0 && p.calibrationRadius <= 64, "calibrate must be in [0, 64]");
+  require(p.calibrationRadius >= 0 && p.calibrationRadius <= kMaxCalibrationRadius,
+          "calibrate must be in [0, " + std::to_string(kMaxCalibrationRadius) + "]");
   require(std::isfinite(p.alpha) && p.alpha >= 0, "alpha must be ≥ 0");
   require(std::isfinite(p.tau) && p.tau >= 0, "tau must be ≥ 0");
   require(validKnee(p.varianceKnee), "varianceKnee must be 0 (off) or positive");

@@ -78,14 +78,13 @@ float sureSmoothingWidth(double spp) {
   return float(std::clamp(16.0 / std::sqrt(spp), 2.0, 8.0));
 }
 
-SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params,
-                 const Image* calibratedVariance) {
+SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params, const Image* sureVariance) {
   const int w = buffer.width(), h = buffer.height();
   const size_t pixels = size_t(w) * size_t(h);
   const int candidateCount = int(params.sigmaS.size());
   const PlanarImage color = sanitizedMean(buffer.color);
   const PlanarImage variance = sanitizedVarianceOfMean(
-      calibratedVariance ? MeanVariance{buffer.color.mean, *calibratedVariance} : buffer.color);
+      sureVariance ? MeanVariance{buffer.color.mean, *sureVariance} : buffer.color);
   const FeatureGuide guide =
       makeFeatureGuide(buffer, {params.sigmaN, params.sigmaR, params.sigmaD});
 
@@ -125,7 +124,7 @@ SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params,
       kneeLevel({color.plane(0), size_t(3) * pixels}, params.selectionKnee));
   const float sigmaMse =
       (params.sigmaMse > 0 ? params.sigmaMse : sureSmoothingWidth(meanSampleCount(buffer))) *
-      (calibratedVariance ? kCalibratedSureSmoothing : 1.0f);
+      (sureVariance ? kCalibratedSureSmoothing : 1.0f);
   const PlanarImage smoothed = crossBilateralSmooth(sure, guide, sigmaMse);
 
   // 4. Hard per-pixel selection; ties go to the first candidate in sigmaS order.

@@ -64,10 +64,10 @@ float sureSmoothingWidth(double spp);
 inline constexpr float kCalibratedSureSmoothing = 1.5f;
 
 // Runs SBF on one buffer (colour, its variance of the mean, normal, albedo, depth, sample count);
-// with `calibratedVariance`, SURE takes that variance of the colour's mean instead of the
-// buffer's and smooths its maps kCalibratedSureSmoothing times wider.
+// with `sureVariance` (the calibrated one), SURE takes that variance of the colour's mean instead
+// of the buffer's and smooths its maps kCalibratedSureSmoothing times wider.
 SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params,
-                 const Image* calibratedVariance = nullptr);
+                 const Image* sureVariance = nullptr);
 
 class Sbf : public BaseDenoiser {
  public:

@@ -26,9 +26,9 @@ TEST(Bilateral, IsTheSharedFilterWithTheColourTerm) {
   const test::SyntheticScene scene = test::syntheticScene(64);
   const SubBuffer& b = scene.fullInput().whole;
   const float sigmaS[] = {4.0f};
-  const auto expected =
-      crossBilateralCandidates(sanitizedMean(b.color), sanitizedVarianceOfMean(b.color),
-                               makeFeatureGuide(b, {}), sigmaS, 3.0f);
+  const auto expected = crossBilateralCandidates(sanitizedMean(b.color),
+                                                 sanitizedVarianceOfMean(b.color.varianceOfMean),
+                                                 makeFeatureGuide(b, {}), sigmaS, 3.0f);
   EXPECT_TRUE(
       test::bitIdentical(Bilateral().run(scene.fullInput()), expected[0].filtered.toImage()));
 }

@@ -82,7 +82,8 @@ NaiveResult naive(const SubBuffer& b, int px, int py, int c, float sigmaS, float
 
 std::vector<BilateralCandidate> filter(const SubBuffer& b, const std::vector<float>& sigmaS,
                                        float sigmaC, const FeatureSigmas& sigmas = {}) {
-  return crossBilateralCandidates(sanitizedMean(b.color), sanitizedVarianceOfMean(b.color),
+  return crossBilateralCandidates(sanitizedMean(b.color),
+                                  sanitizedVarianceOfMean(b.color.varianceOfMean),
                                   makeFeatureGuide(b, sigmas), sigmaS, sigmaC);
 }
 

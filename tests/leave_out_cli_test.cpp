@@ -109,8 +109,6 @@ TEST(LeaveOutCli, ARenderForMembersThatReadFewerFeaturesRecordsOnlyThose) {
   EXPECT_FALSE(fs::exists(dir / "later" / "stats.json"));
 }
 
-// By default a render writes what a user looks at and render.exr; --keep adds exactly the files
-// it lists, and stats.json lists what was written and what was left out.
 // A member that calibrates its colour variance to the halves (calibrate=R) reads them although
 // it does not need them: a render for it keeps the full buffer's halves. It did not (a render
 // with atrous:calibrate=3 wrote the bits of plain atrous: the option did nothing there).
@@ -130,6 +128,8 @@ TEST(LeaveOutCli, MembersThatCalibrateGetTheHalves) {
   }
 }
 
+// By default a render writes what a user looks at and render.exr; --keep adds exactly the files
+// it lists, and stats.json lists what was written and what was left out.
 TEST(LeaveOutCli, RenderWritesMemberAndWeightFilesOnlyWithKeep) {
   TempDir dir;
   const std::vector<std::string> base = {"render", cornellBox(), "--width",   "12",

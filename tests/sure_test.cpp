@@ -125,7 +125,8 @@ FilterFn bilateral(float sigmaS, float sigmaC) {
   return [=](const Image& noisy, const Image& variance) {
     const SubBuffer b = bufferWithFeatures(noisy, variance);
     const float sigmas[] = {sigmaS};
-    auto cand = crossBilateralCandidates(sanitizedMean(b.color), sanitizedVarianceOfMean(b.color),
+    auto cand = crossBilateralCandidates(sanitizedMean(b.color),
+                                         sanitizedVarianceOfMean(b.color.varianceOfMean),
                                          makeFeatureGuide(b, {}), sigmas, sigmaC);
     return Filtered{cand[0].filtered.toImage(), cand[0].derivative.toImage()};
   };

@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <random>
 
 #include "tests/support/gaussian_buffers.h"
 
@@ -62,29 +61,8 @@ TEST(VarianceCalibration, BringsAnOverstatedVarianceToTheHalvesLevel) {
 // variance s² / 12, and (h1 − h2)² · 4 · 8 / 12² estimates it without bias; with the equal-count
 // weight ¼ it would come out 12.5 % high.
 TEST(VarianceCalibration, WeighsHalvesOfUnequalCountsWithoutBias) {
-  std::mt19937 rng(11);
-  std::normal_distribution<float> normal(0.0f, 1.0f);
-  const float s = 0.2f, n1 = 4, n2 = 8;
-  DenoiseInput input;
-  input.whole = test::flatFeatures(kSize, kSize, n1 + n2);
-  input.halves = std::array<SubBuffer, 2>{test::flatFeatures(kSize, kSize, n1),
-                                          test::flatFeatures(kSize, kSize, n2)};
-  SubBuffer& a = (*input.halves)[0];
-  SubBuffer& b = (*input.halves)[1];
-  for (SubBuffer* buffer : {&input.whole, &a, &b}) {
-    buffer->color.mean = Image(kSize, kSize, 3);
-    buffer->color.varianceOfMean = Image(kSize, kSize, 3);
-  }
-  for (size_t k = 0; k < input.whole.color.mean.size(); ++k) {
-    const float x1 = 0.5f + s / std::sqrt(n1) * normal(rng);
-    const float x2 = 0.5f + s / std::sqrt(n2) * normal(rng);
-    a.color.mean.data()[k] = x1;
-    b.color.mean.data()[k] = x2;
-    input.whole.color.mean.data()[k] = (n1 * x1 + n2 * x2) / (n1 + n2);
-    a.color.varianceOfMean.data()[k] = s * s / n1;
-    b.color.varianceOfMean.data()[k] = s * s / n2;
-    input.whole.color.varianceOfMean.data()[k] = s * s / (n1 + n2);  // exact: factor 1 expected
-  }
+  // Exact recorded variances: factor 1 expected.
+  const DenoiseInput input = test::unequalHalves(kSize, 4, 8, 0.2f, 11);
   const Image factor = colorVarianceCalibration(input, 3);
   double mean = 0;
   for (size_t k = 0; k < factor.size(); ++k) mean += factor.data()[k];

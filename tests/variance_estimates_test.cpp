@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
 
 #include "tests/support/gaussian_buffers.h"
 
@@ -16,33 +15,8 @@ namespace {
 constexpr int kSize = 64;
 constexpr float kSigma = 0.2f;  // per-sample standard deviation
 
-// Halves of n1 and n2 samples of i.i.d. noise around 0.5 with exact recorded variances, except
-// that a one-sample buffer records 0 (M2 / (n (n − 1)) is undefined), as the film does.
 DenoiseInput halvesOf(float n1, float n2, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<float> normal(0.0f, 1.0f);
-  DenoiseInput input;
-  input.whole = test::flatFeatures(kSize, kSize, n1 + n2);
-  input.halves = std::array<SubBuffer, 2>{test::flatFeatures(kSize, kSize, n1),
-                                          test::flatFeatures(kSize, kSize, n2)};
-  SubBuffer& a = (*input.halves)[0];
-  SubBuffer& b = (*input.halves)[1];
-  for (SubBuffer* buffer : {&input.whole, &a, &b}) {
-    buffer->color.mean = Image(kSize, kSize, 3);
-    buffer->color.varianceOfMean = Image(kSize, kSize, 3);
-  }
-  auto recorded = [](float n) { return n >= 2 ? kSigma * kSigma / n : 0.0f; };
-  for (size_t k = 0; k < input.whole.color.mean.size(); ++k) {
-    const float x1 = 0.5f + kSigma / std::sqrt(n1) * normal(rng);
-    const float x2 = 0.5f + kSigma / std::sqrt(n2) * normal(rng);
-    a.color.mean.data()[k] = x1;
-    b.color.mean.data()[k] = x2;
-    input.whole.color.mean.data()[k] = (n1 * x1 + n2 * x2) / (n1 + n2);
-    a.color.varianceOfMean.data()[k] = recorded(n1);
-    b.color.varianceOfMean.data()[k] = recorded(n2);
-    input.whole.color.varianceOfMean.data()[k] = recorded(n1 + n2);
-  }
-  return input;
+  return test::unequalHalves(kSize, n1, n2, kSigma, seed);
 }
 
 double meanOf(const Image& image) {
@@ -86,8 +60,8 @@ TEST(VarianceEstimates, OneSampleWholeKeepsARoughEstimate) {
   input.whole.sampleCount.fill(1.0f);
   (*input.halves)[1].sampleCount.fill(0.0f);
   const Image whole = wholeVarianceOfMean(input, Quantity::Color);
-  const Image expected = twoBufferVariance((*input.halves)[0], (*input.halves)[1],
-                                           Quantity::Color, TwoBufferTarget::Whole);
+  const Image expected = twoBufferVariance((*input.halves)[0], (*input.halves)[1], Quantity::Color,
+                                           TwoBufferTarget::Whole);
   for (size_t k = 0; k < whole.size(); ++k) {
     ASSERT_TRUE(std::isfinite(whole.data()[k]));
     ASSERT_EQ(whole.data()[k], expected.data()[k]);

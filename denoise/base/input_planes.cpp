@@ -19,8 +19,8 @@ Image clampedFinite(const Image& image) {
   return out;
 }
 
-PlanarImage sanitizedVarianceOfMean(const MeanVariance& quantity) {
-  PlanarImage out(quantity.varianceOfMean);
+PlanarImage sanitizedVarianceOfMean(const Image& varianceOfMean) {
+  PlanarImage out(varianceOfMean);
   for (int c = 0; c < out.channels(); ++c) {
     float* p = out.plane(c);
     for (size_t i = 0; i < out.pixelCount(); ++i)

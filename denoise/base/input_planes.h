@@ -25,7 +25,7 @@ inline float clampedFinite(float v) {
 // An image with every value clamped by clampedFinite.
 Image clampedFinite(const Image& image);
 // Variance of the mean with non-finite or negative values replaced by 0 (colour: "noise-free").
-PlanarImage sanitizedVarianceOfMean(const MeanVariance& quantity);
+PlanarImage sanitizedVarianceOfMean(const Image& varianceOfMean);
 
 // Per-sample variance of a feature, M2 / (n − 1) = varianceOfMean × n (Li et al. 2012 use the
 // spread of the samples, not of the mean). n < 2 has varianceOfMean = 0 and gives 0; a pixel

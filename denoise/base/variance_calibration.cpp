@@ -58,4 +58,10 @@ Image calibratedVariance(const Image& variance, const Image& factor) {
   return out;
 }
 
+Image calibratedWholeColorVariance(const DenoiseInput& input, int radius, float maxFactor) {
+  const Image factor = colorVarianceCalibration(input, radius, maxFactor);
+  if (factor.empty()) return {};
+  return calibratedVariance(input.whole.color.varianceOfMean, factor);
+}
+
 }  // namespace chorus

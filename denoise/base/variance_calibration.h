@@ -35,4 +35,9 @@ Image colorVarianceCalibration(const DenoiseInput& input, int radius,
 // variance × factor per element (variance itself when factor is empty). Same shape required.
 Image calibratedVariance(const Image& variance, const Image& factor);
 
+// input.whole's colour variance of the mean calibrated (the two calls above), or an empty image
+// where there is nothing to calibrate against (no halves, radius 0).
+Image calibratedWholeColorVariance(const DenoiseInput& input, int radius,
+                                   float maxFactor = std::numeric_limits<float>::infinity());
+
 }  // namespace chorus

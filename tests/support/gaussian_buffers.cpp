@@ -1,6 +1,7 @@
 #include "tests/support/gaussian_buffers.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -58,6 +59,33 @@ OverstatedDetail overstatedDetail(int size, float samples, float factor, uint32_
   d.input = gaussianHalves(d.scene.truth, d.scene.sigma, flatFeatures(size, size, samples), seed);
   overstateColorVariances(d.input, factor);
   return d;
+}
+
+DenoiseInput unequalHalves(int size, float n1, float n2, float sigma, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  DenoiseInput input;
+  input.whole = flatFeatures(size, size, n1 + n2);
+  input.halves =
+      std::array<SubBuffer, 2>{flatFeatures(size, size, n1), flatFeatures(size, size, n2)};
+  SubBuffer& a = (*input.halves)[0];
+  SubBuffer& b = (*input.halves)[1];
+  for (SubBuffer* buffer : {&input.whole, &a, &b}) {
+    buffer->color.mean = Image(size, size, 3);
+    buffer->color.varianceOfMean = Image(size, size, 3);
+  }
+  auto recorded = [&](float n) { return n >= 2 ? sigma * sigma / n : 0.0f; };
+  for (size_t k = 0; k < input.whole.color.mean.size(); ++k) {
+    const float x1 = 0.5f + sigma / std::sqrt(n1) * normal(rng);
+    const float x2 = 0.5f + sigma / std::sqrt(n2) * normal(rng);
+    a.color.mean.data()[k] = x1;
+    b.color.mean.data()[k] = x2;
+    input.whole.color.mean.data()[k] = (n1 * x1 + n2 * x2) / (n1 + n2);
+    a.color.varianceOfMean.data()[k] = recorded(n1);
+    b.color.varianceOfMean.data()[k] = recorded(n2);
+    input.whole.color.varianceOfMean.data()[k] = recorded(n1 + n2);
+  }
+  return input;
 }
 
 SubBuffer flatFeatures(int width, int height, float samples) {

@@ -36,6 +36,12 @@ struct OverstatedDetail {
 };
 OverstatedDetail overstatedDetail(int size, float samples, float factor, uint32_t seed);
 
+// Halves of n1 and n2 samples of i.i.d. Gaussian noise (per-sample σ `sigma`) around 0.5 on
+// flatFeatures of size × size, the whole their count-weighted mean, with exact recorded variances
+// σ²/n, except that a buffer of fewer than 2 samples records 0 (M2 / (n (n − 1)) is undefined),
+// as the film does.
+DenoiseInput unequalHalves(int size, float n1, float n2, float sigma, uint32_t seed);
+
 // Features of one flat, featureless surface: albedo 0.5, normal +z, depth 2, visibility 1, and
 // `samples` samples per pixel.
 SubBuffer flatFeatures(int width, int height, float samples);

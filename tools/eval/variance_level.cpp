@@ -58,8 +58,7 @@ void run(const std::string& renderPath, const std::string& referencePath, int ra
   const double error = relMse(full.whole.color.mean, reference);
   const double recorded = relativeMean(recordedVariance, reference);
   const double spread = relativeMean(subBufferSpread(buffers), reference);
-  const double calibrated = relativeMean(
-      calibratedVariance(recordedVariance, colorVarianceCalibration(full, radius)), reference);
+  const double calibrated = relativeMean(calibratedWholeColorVariance(full, radius), reference);
   std::printf(
       "%s: K %d, error %.4g; recorded variance %.4g (%.2fx the error), sub-buffer spread "
       "%.4g (%.2fx), calibrated %.4g (%.2fx)\n",

@@ -447,11 +447,9 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& given, AtrousKernel
 }
 
 Image Atrous::run(const DenoiseInput& input) const {
-  const Image factor = colorVarianceCalibration(input, params_.calibrationRadius);
-  if (factor.empty())
-    return runAtrous(input.whole, params_, AtrousKernelPath::Widest, input.sampleShare);
-  const Image variance = calibratedVariance(input.whole.color.varianceOfMean, factor);
-  return runAtrous(input.whole, params_, AtrousKernelPath::Widest, input.sampleShare, &variance);
+  const Image variance = calibratedWholeColorVariance(input, params_.calibrationRadius);
+  return runAtrous(input.whole, params_, AtrousKernelPath::Widest, input.sampleShare,
+                   variance.empty() ? nullptr : &variance);
 }
 
 }  // namespace chorus

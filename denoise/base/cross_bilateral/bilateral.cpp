@@ -27,7 +27,7 @@ Image Bilateral::run(const DenoiseInput& input) const {
   const SubBuffer& buffer = input.whole;
   const float sigmaS[] = {params_.sigmaS};
   const std::vector<BilateralCandidate> filtered = crossBilateralCandidates(
-      sanitizedMean(buffer.color), sanitizedVarianceOfMean(buffer.color),
+      sanitizedMean(buffer.color), sanitizedVarianceOfMean(buffer.color.varianceOfMean),
       makeFeatureGuide(buffer, {params_.sigmaN, params_.sigmaR, params_.sigmaD}), sigmaS,
       params_.sigmaC);
   Image out = filtered[0].filtered.toImage();

@@ -83,8 +83,8 @@ SbfResult runSbf(const SubBuffer& buffer, const SbfParams& params, const Image* 
   const size_t pixels = size_t(w) * size_t(h);
   const int candidateCount = int(params.sigmaS.size());
   const PlanarImage color = sanitizedMean(buffer.color);
-  const PlanarImage variance = sanitizedVarianceOfMean(
-      sureVariance ? MeanVariance{buffer.color.mean, *sureVariance} : buffer.color);
+  const PlanarImage variance =
+      sanitizedVarianceOfMean(sureVariance ? *sureVariance : buffer.color.varianceOfMean);
   const FeatureGuide guide =
       makeFeatureGuide(buffer, {params.sigmaN, params.sigmaR, params.sigmaD});
 
@@ -149,11 +149,9 @@ Image Sbf::run(const DenoiseInput& input) const {
   const bool calibrate =
       params_.calibrationRadius > 0 &&
       renderSamplesPerPixel(input.whole, input.sampleShare) >= params_.calibrateFrom;
-  const Image factor =
-      calibrate ? colorVarianceCalibration(input, params_.calibrationRadius, 1.0f) : Image();
-  if (factor.empty()) return runSbf(input.whole, params_).output;
-  const Image variance = calibratedVariance(input.whole.color.varianceOfMean, factor);
-  return runSbf(input.whole, params_, &variance).output;
+  const Image variance =
+      calibrate ? calibratedWholeColorVariance(input, params_.calibrationRadius, 1.0f) : Image();
+  return runSbf(input.whole, params_, variance.empty() ? nullptr : &variance).output;
 }
 
 }  // namespace chorus

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <functional>
 #include <limits>
 #include <numbers>
@@ -128,8 +129,9 @@ class PartGuard {
       rowCounts[size_t(y)] = guardRow(y, out, changed, rowExcess[size_t(y)]);
     });
     // In raster order, so that the sums do not depend on the thread count.
+    SpreadKernels kernels;
     for (const std::vector<Excess>& excesses : rowExcess)
-      for (const Excess& excess : excesses) spread(excess, out, changed);
+      for (const Excess& excess : excesses) spread(excess, kernels, out, changed);
     return std::accumulate(rowCounts.begin(), rowCounts.end(), size_t(0));
   }
 
@@ -155,23 +157,40 @@ class PartGuard {
     return wanted > r ? int(std::ceil(std::min(wanted, double(kMaxGuardSpread)))) : r;
   }
 
+  // The Gaussians g of spread by radius, g(dx, dy) at |dy| (r + 1) + |dx|: computed once per
+  // radius instead of twice per pixel of every window (the spread is the guard's serial part).
+  struct SpreadKernels {
+    std::array<std::vector<double>, kMaxGuardSpread + 1> byRadius;
+    const std::vector<double>& of(int r) {
+      std::vector<double>& g = byRadius[size_t(r)];
+      if (g.empty()) {
+        const double falloff = 2.0 / (double(r) * double(r));  // 1 / (2 σ²), σ = r / 2
+        g.resize(size_t(r + 1) * size_t(r + 1));
+        for (int dy = 0; dy <= r; ++dy)
+          for (int dx = 0; dx <= r; ++dx)
+            g[size_t(dy * (r + 1) + dx)] = std::exp(-double(dx * dx + dy * dy) * falloff);
+      }
+      return g;
+    }
+  };
+
   // Adds amount × g(q) s(q) / Σ g to every pixel q of the (2 e.radius + 1)² window inside
   // the image, the outlier's own included, with the Gaussian g(q) = exp(−|q − p|² / (2 (r/2)²))
   // and s(q) = sameSurface: on one surface the window keeps the outlier's energy, without the
   // edges a box would draw. The share that falls on other surfaces is dropped, not given to the
   // outlier's surface: on a thin one (a lamp's arm, a few pixels wide) that concentrated an
   // excess of the whole window onto a handful of pixels (0.96 where the reference is 0.004).
-  void spread(const Excess& e, MeanVariance& out, std::vector<uint8_t>& changed) const {
+  void spread(const Excess& e, SpreadKernels& kernels, MeanVariance& out,
+              std::vector<uint8_t>& changed) const {
     const int w = part_.width(), h = part_.height(), r = e.radius;
     const int x0 = std::max(0, e.x - r), x1 = std::min(w - 1, e.x + r);
     const int y0 = std::max(0, e.y - r), y1 = std::min(h - 1, e.y + r);
-    const double falloff = 2.0 / (double(r) * double(r));  // 1 / (2 σ²), σ = r / 2
     const Image& depth = part_.depth.mean;
     const bool hasDepth = depth.sameSize(part_.color.mean);
     const double here = hasDepth ? depth(e.x, e.y, 0) : 0.0;
+    const std::vector<double>& g = kernels.of(r);
     auto gaussian = [&](int x, int y) {
-      const double dx = x - e.x, dy = y - e.y;
-      return std::exp(-(dx * dx + dy * dy) * falloff);
+      return g[size_t(std::abs(y - e.y) * (r + 1) + std::abs(x - e.x))];
     };
     double total = 0;
     for (int y = y0; y <= y1; ++y)

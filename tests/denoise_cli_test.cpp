@@ -280,6 +280,15 @@ TEST(DenoiseCli, MembersAloneOnAOneSubBufferRender) {
   EXPECT_FALSE(fs::exists(two / "weights.exr"));
   const Image again = readExrLayer(two / "atrous.exr");
   EXPECT_TRUE(std::equal(again.values().begin(), again.values().end(), written.values().begin()));
+  EXPECT_EQ(lineCount(r.out), 5) << r.out;  // "wrote" each member's EXR and stats.json
+
+  // --quiet: the same files, nothing on either stream (the progress line needs a terminal).
+  const fs::path quiet = dir / "quiet";
+  r = runChorus(
+      {"denoise", render.string(), "--methods", "atrous", "--quiet", "--out", quiet.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.out + r.err, "");
+  EXPECT_EQ(filesIn(quiet), (std::vector<std::string>{"atrous.exr", "atrous.png", "stats.json"}));
 
   // A member that needs halves: one line naming the file, the member and the fix; nothing
   // written.

@@ -157,6 +157,40 @@ TEST(EnsembleRunner, TheQuartersEstimateRunsTheHeldOutInputsInsteadOfTheHalves) 
   EXPECT_TRUE(two.bases[0].heldOut.empty());
 }
 
+// Progress reports every run once, in order of completion: 0 of N first, then 1 … N, each naming
+// a run of the stage times; the same for members run alone.
+TEST(EnsembleRunner, ReportsEveryRunsEndToTheProgressCallback) {
+  const SampleBuffers b = buffers(4);
+  for (const MseEstimate estimate : {MseEstimate::Quarters, MseEstimate::Extrapolated}) {
+    std::vector<RunsProgress> reports;
+    const EnsembleResult result =
+        Ensemble(boxMembers(), withEstimate(estimate))
+            .run(sourcesFromBuffers(b), nullptr,
+                 [&reports](const RunsProgress& p) { reports.push_back(p); });
+    std::set<std::string> runs = stagesOf(result), reported;
+    for (const char* notRun : {"bases", "solve", "filter", "blend"}) runs.erase(notRun);
+    ASSERT_EQ(reports.size(), runs.size() + 1);  // 8 held-out runs, or 14 with the halves
+    EXPECT_EQ(runs.size(), estimate == MseEstimate::Quarters ? 8u : 14u);
+    for (size_t i = 0; i < reports.size(); ++i) {
+      EXPECT_EQ(reports[i].done, i);
+      EXPECT_EQ(reports[i].total, runs.size());
+      if (i == 0) {
+        EXPECT_TRUE(reports[i].finished.empty());
+      } else {
+        reported.insert(reports[i].finished);
+      }
+    }
+    EXPECT_EQ(reported, runs);
+  }
+  std::vector<RunsProgress> alone;
+  runMembersAlone(b.input(BufferPart::Full), boxMembers(), nullptr,
+                  [&alone](const RunsProgress& p) { alone.push_back(p); });
+  ASSERT_EQ(alone.size(), 3u);
+  EXPECT_EQ(alone.back().done, 2u);
+  EXPECT_EQ(alone.back().total, 2u);
+  EXPECT_TRUE(alone[1].finished == "box1/full" || alone[1].finished == "box3/full");
+}
+
 // On an image of kFullRunPixels pixels at up to kFullRunSpp samples per pixel the quarters
 // estimate also runs each member on the full buffer and blends that run (not the mean of the
 // held-out runs); one sample per pixel more and it blends the mean again.

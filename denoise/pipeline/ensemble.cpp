@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <set>
 #include <string>
 
@@ -64,20 +65,47 @@ void checkMembersCanRunAlone(const DenoiseInput& input, std::span<const Ensemble
                   "' needs two independent halves of its input, and this input has none");
 }
 
+namespace {
+
+// Counts finished runs and hands each to the callback, one call at a time.
+class RunsCounter {
+ public:
+  // Reports 0 of `total` at once, so that a display shows the runs before the first ends.
+  RunsCounter(size_t total, const RunsProgressCallback& callback)
+      : total_(total), callback_(callback) {
+    if (callback_) callback_({0, total_, {}, 0});
+  }
+  void finished(const std::string& name, double seconds) {
+    if (!callback_) return;
+    const std::lock_guard lock(mutex_);
+    callback_({++done_, total_, name, seconds});
+  }
+
+ private:
+  size_t done_ = 0, total_;
+  const RunsProgressCallback& callback_;
+  std::mutex mutex_;
+};
+
+}  // namespace
+
 std::vector<Image> runMembersAlone(const DenoiseInput& input,
                                    std::span<const EnsembleMember> members,
-                                   std::vector<StageTime>* times) {
+                                   std::vector<StageTime>* times,
+                                   const RunsProgressCallback& progress) {
   checkMembersCanRunAlone(input, members);
   const Stopwatch all;
   std::vector<Image> outputs(members.size());
   std::vector<double> seconds(members.size());
   const MemberRunner runner(input, members);
+  RunsCounter counter(members.size(), progress);
   tbb::task_group group;
   for (size_t m = 0; m < members.size(); ++m)
     group.run([&, m] {
       const Stopwatch run;
       outputs[m] = runner.run(m);
       seconds[m] = run.seconds();
+      counter.finished(members[m].label + "/full", seconds[m]);
     });
   group.wait();
   if (times) {
@@ -124,7 +152,8 @@ CombineOptions optionsForRuns(CombineOptions options, const BaseRuns& runs,
 
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
-                                          std::vector<StageTime>* times, BaseRuns runs) {
+                                          std::vector<StageTime>* times, BaseRuns runs,
+                                          const RunsProgressCallback& progress) {
   checkMembersCanRun(sources, members);
   const Stopwatch all;
   if (!runs.full && !runs.heldOut)
@@ -166,6 +195,7 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
     if (runs.heldOut) outputs[m].heldOut.resize(kHeldOutQuarters);
   }
   std::vector<double> seconds(members.size() * parts);
+  RunsCounter counter(members.size() * parts, progress);
   // Every member on parts [first, last), on `input` or else each part's own.
   const auto runParts = [&](size_t first, size_t last, const DenoiseInput* input) {
     std::vector<std::unique_ptr<const MemberRunner>> runners(last - first);
@@ -184,6 +214,7 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
           const Stopwatch clock;
           *target = runner->run(m);
           seconds[m * parts + part] = clock.seconds();
+          counter.finished(members[m].label + "/" + plan[part].name, seconds[m * parts + part]);
         });
       }
     group.wait();
@@ -216,10 +247,11 @@ EnsembleResult Ensemble::run(const SampleBuffers& buffers, const Image* referenc
   return run(sourcesFromBuffers(buffers), reference);
 }
 
-EnsembleResult Ensemble::run(const EnsembleSources& sources, const Image* reference) const {
+EnsembleResult Ensemble::run(const EnsembleSources& sources, const Image* reference,
+                             const RunsProgressCallback& progress) const {
   EnsembleResult result;
   const BaseRuns runs = baseRunsFor(options_.mse, sources);
-  result.bases = runBaseDenoisers(sources, members_, &result.times, runs);
+  result.bases = runBaseDenoisers(sources, members_, &result.times, runs, progress);
   result.guides = guidesFromSources(sources, runs.heldOut);
   result.combined = combine(result.guides, pointersTo(result.bases),
                             optionsForRuns(options_, runs, members_), reference);

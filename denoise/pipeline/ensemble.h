@@ -5,6 +5,7 @@
 // the time of every stage. For sweeps that reuse base outputs across combinations, call
 // runBaseDenoisers() once and combine() per combination instead. runMembersAlone() runs members
 // on one input only, without the ensemble (`chorus denoise --combine none`).
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -26,6 +27,16 @@ struct EnsembleMember {
 // One member per registry spec ("nfor", "jnlm:k=0.4"), labelled with the spec. Throws
 // chorus::Error for an unknown name or parameter (denoise/base/registry.h).
 std::vector<EnsembleMember> membersFromSpecs(std::span<const std::string> specs);
+
+// Progress of the member runs, for a command's progress display: called with done = 0 before
+// any run starts, then once as each run ends (from the thread that ran it, one call at a time):
+// `done` of `total` runs finished, the last one named as in the stage times ("nfor/without-q0").
+struct RunsProgress {
+  size_t done = 0, total = 0;
+  std::string finished;
+  double seconds = 0;  // of that run
+};
+using RunsProgressCallback = std::function<void(const RunsProgress&)>;
 
 // Throws chorus::Error (one line) when a member cannot run on these sources, e.g. a denoiser
 // that needs two halves of its own input while the half buffers have none (K = 2 renders and
@@ -51,7 +62,8 @@ void checkMembersCanRunAlone(const DenoiseInput& input, std::span<const Ensemble
 // them) to `times`.
 std::vector<Image> runMembersAlone(const DenoiseInput& input,
                                    std::span<const EnsembleMember> members,
-                                   std::vector<StageTime>* times = nullptr);
+                                   std::vector<StageTime>* times = nullptr,
+                                   const RunsProgressCallback& progress = {});
 
 // Which runs of every member the ensemble needs.
 struct BaseRuns {
@@ -88,11 +100,12 @@ CombineOptions optionsForRuns(CombineOptions options, const BaseRuns& runs,
                               std::span<const EnsembleMember> members);
 // Every member on the runs that `runs` asks for, in parallel. Appends "<label>/A",
 // "<label>/B", "<label>/full", "<label>/without-q<k>" (the time of each run) and "bases" (wall
-// time of all of them) to `times`.
+// time of all of them) to `times`; reports each run's end to `progress`.
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
                                           std::vector<StageTime>* times = nullptr,
-                                          BaseRuns runs = {});
+                                          BaseRuns runs = {},
+                                          const RunsProgressCallback& progress = {});
 
 struct EnsembleResult {
   CombineResult combined;          // image, weights, A/B blends, estimated MSE
@@ -110,7 +123,8 @@ class Ensemble {
 
   // From K = 2 or 4 sub-buffers (input(HalfA), input(HalfB), input(Full)).
   EnsembleResult run(const SampleBuffers& buffers, const Image* reference = nullptr) const;
-  EnsembleResult run(const EnsembleSources& sources, const Image* reference = nullptr) const;
+  EnsembleResult run(const EnsembleSources& sources, const Image* reference = nullptr,
+                     const RunsProgressCallback& progress = {}) const;
 
  private:
   std::vector<EnsembleMember> members_;

@@ -35,6 +35,7 @@
 #include "tools/chorus/ensemble_outputs.h"
 #include "tools/chorus/flag_checks.h"
 #include "tools/chorus/kept_outputs.h"
+#include "tools/chorus/progress_bar.h"
 
 namespace chorus::cli {
 namespace {
@@ -48,6 +49,7 @@ struct DenoiseArgs {
   std::string reference;
   EnsembleFlags ensemble;
   KeptOutputs keep;
+  bool quiet = false;
 };
 
 // An input as read, before any member runs: the buffers built-in members run on (a render.exr's
@@ -129,7 +131,8 @@ struct MemberRuns {
 
 // --combine none: each member alone on the full buffer (an outputs directory's full outputs are
 // taken as they are).
-MemberRuns runAlone(ReadInput& input, const std::vector<std::string>& specs) {
+MemberRuns runAlone(ReadInput& input, const std::vector<std::string>& specs,
+                    const RunsProgressCallback& progress) {
   MemberRuns runs;
   if (input.outputs) {
     runs.bases = std::move(input.outputs->bases);
@@ -145,7 +148,7 @@ MemberRuns runAlone(ReadInput& input, const std::vector<std::string>& specs) {
   } catch (const Error& e) {
     throw fileError(input.path, e.what() + inputHint(input, true));
   }
-  std::vector<Image> images = runMembersAlone(full, members, &runs.times);
+  std::vector<Image> images = runMembersAlone(full, members, &runs.times, progress);
   for (size_t m = 0; m < members.size(); ++m)
     runs.bases.push_back({members[m].label, {}, {}, std::move(images[m]), {}});
   return runs;
@@ -154,7 +157,8 @@ MemberRuns runAlone(ReadInput& input, const std::vector<std::string>& specs) {
 // Every member on half A, half B and the full buffer (and the held-out inputs when the estimate
 // uses them), for the combiners.
 MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& specs,
-                          const MseOptions& mse, EnsembleGuides* guides) {
+                          const MseOptions& mse, EnsembleGuides* guides,
+                          const RunsProgressCallback& progress) {
   MemberRuns runs;
   if (input.outputs) {
     runs.bases = std::move(input.outputs->bases);
@@ -168,14 +172,14 @@ MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& spec
   try {
     // The full buffer's halves, when a run on it needs them, are built for that run only
     // (runBaseDenoisers).
-    sources =
-        input.render ? sourcesFromBuffers(*input.render, false) : sourcesFromHalves(*input.tungsten);
+    sources = input.render ? sourcesFromBuffers(*input.render, false)
+                           : sourcesFromHalves(*input.tungsten);
     checkMembersCanRun(sources, members);
   } catch (const Error& e) {
     throw fileError(input.path, e.what() + inputHint(input, false));
   }
   runs.used = baseRunsFor(mse, sources);
-  runs.bases = runBaseDenoisers(sources, members, &runs.times, runs.used);
+  runs.bases = runBaseDenoisers(sources, members, &runs.times, runs.used, progress);
   *guides = guidesFromSources(sources, runs.used.heldOut);
   return runs;
 }
@@ -204,11 +208,17 @@ std::vector<Combiner> combinersOf(const std::string& list, size_t methodCount) {
   return combiners;
 }
 
-void writeStats(const fs::path& out, Json& stats, Json& times, const Stopwatch& total) {
+// "wrote PATH" on stdout, unless --quiet.
+void reportWritten(const DenoiseArgs& args, const fs::path& path) {
+  if (!args.quiet) std::cout << "wrote " << path.string() << "\n";
+}
+
+void writeStats(const DenoiseArgs& args, Json& stats, Json& times, const Stopwatch& total) {
   times["total"] = total.seconds();
   stats["seconds"] = times;
-  writeTextAtomically(out / "stats.json", stats.dump(2) + "\n");
-  std::cout << "wrote " << (out / "stats.json").string() << "\n";
+  const fs::path path = fs::path(args.out) / "stats.json";
+  writeTextAtomically(path, stats.dump(2) + "\n");
+  reportWritten(args, path);
 }
 
 void runDenoise(const DenoiseArgs& args) {
@@ -247,8 +257,11 @@ void runDenoise(const DenoiseArgs& args) {
     metrics["noisy"] = metricsJson(noisyColor(input), *reference);
   }
 
+  // The members' runs on a terminal line (they take most of the time), unless --quiet.
+  RunsProgressLine progress(!args.quiet && TerminalLine::stderrIsTerminal());
   if (combiners.empty()) {
-    const MemberRuns runs = runAlone(input, specs);
+    const MemberRuns runs = runAlone(input, specs, progress.callback());
+    progress.finish();
     for (const StageTime& t : runs.times) times[t.stage] = t.seconds;
     ensureDirectory(out);
     const Stopwatch write;
@@ -258,17 +271,18 @@ void runDenoise(const DenoiseArgs& args) {
       writePng(out / (base.name + ".png"), base.full);
       written.insert(written.end(), {base.name + ".exr", base.name + ".png"});
       if (reference) metrics[base.name] = metricsJson(base.full, *reference);
-      std::cout << "wrote " << (out / (base.name + ".exr")).string() << "\n";
+      reportWritten(args, out / (base.name + ".exr"));
     }
     times["write"] = write.seconds();
     written.push_back("stats.json");
     stats["outputs"] = outputsJson(written, {});  // the members' outputs are the result
     if (reference) stats["metrics"] = metrics;
-    return writeStats(out, stats, times, total);
+    return writeStats(args, stats, times, total);
   }
 
   EnsembleGuides guides;
-  const MemberRuns runs = runForEnsemble(input, specs, options.mse, &guides);
+  const MemberRuns runs = runForEnsemble(input, specs, options.mse, &guides, progress.callback());
+  progress.finish();
   for (const StageTime& t : runs.times) times[t.stage] = t.seconds;
   checkEnsembleInputs(guides, pointersTo(runs.bases));
   ensureDirectory(out);
@@ -297,7 +311,7 @@ void runDenoise(const DenoiseArgs& args) {
     if (reference) metrics[name] = metricsJson(result.image, *reference);
     if (o.combiner == Combiner::Ensemble)
       stats["noisy_fallback_pixels"] = result.noisyFallbackPixels;
-    std::cout << "wrote " << (out / (name + ".exr")).string() << "\n";
+    reportWritten(args, out / (name + ".exr"));
   }
   if (args.keep.members) {
     const Stopwatch writeBases;
@@ -317,7 +331,7 @@ void runDenoise(const DenoiseArgs& args) {
       metrics[base.name] = metricsJson(base.full, *reference);
     stats["metrics"] = metrics;
   }
-  writeStats(out, stats, times, total);
+  writeStats(args, stats, times, total);
 }
 
 const RegisterCommand denoiseCommand(40, [](CLI::App& app) {
@@ -349,6 +363,7 @@ const RegisterCommand denoiseCommand(40, [](CLI::App& app) {
   cmd->add_option("--reference", args->reference,
                   "Reference image (.exr): relMSE, DSSIM and PSNR of the noisy input, each member "
                   "and each combination in stats.json, and the oracle combiners");
+  cmd->add_flag("--quiet", args->quiet, "No progress line and no \"wrote\" lines");
   cmd->callback([args] { runDenoise(*args); });
 });
 

@@ -137,7 +137,8 @@ void runRender(RenderArgs args) {
   focusCamera(loaded.scene, options);  // a lens its camera cannot take, nothing to focus on
   OwnedDirectory out(args.out);        // held until every file is written
 
-  ProgressBar bar(!args.quiet && ProgressBar::stderrIsTerminal());
+  const bool showProgress = !args.quiet && TerminalLine::stderrIsTerminal();
+  ProgressBar bar(showProgress);
   RenderResult result =
       render::render(loaded.scene, options, [&bar](const RenderProgress& p) { bar.update(p); });
   bar.finish();
@@ -182,8 +183,12 @@ void runRender(RenderArgs args) {
   stats["seconds"]["write render"] = write.seconds();
   result.buffers = {};
   double denoiseSeconds = 0;
-  if (sources)
-    denoiseSeconds = denoise.run(*sources, out.path(), stats, reference ? &*reference : nullptr);
+  if (sources) {
+    RunsProgressLine runs(showProgress);
+    denoiseSeconds = denoise.run(*sources, out.path(), stats, reference ? &*reference : nullptr,
+                                 runs.callback());
+    runs.finish();
+  }
   stats["seconds"]["total"] = total.seconds();
   writeTextAtomically(out.path() / "stats.json", stats.dump(2) + "\n");
 

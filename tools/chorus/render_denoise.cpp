@@ -27,12 +27,13 @@ DenoiseStage DenoiseStage::parse(const std::string& list, CombineOptions options
 }
 
 double DenoiseStage::run(const EnsembleSources& sources, const std::filesystem::path& dir,
-                         nlohmann::ordered_json& stats, const Image* reference) const {
+                         nlohmann::ordered_json& stats, const Image* reference,
+                         const RunsProgressCallback& progress) const {
   const Ensemble ensemble(members, options);
   checkMembersCanRun(sources, ensemble.members());
   checkPlanesHeld(sources.full.whole.planes(), ensemble.members(), true);
   const Stopwatch denoise;
-  const EnsembleResult result = ensemble.run(sources);
+  const EnsembleResult result = ensemble.run(sources, nullptr, progress);
   const double denoiseSeconds = denoise.seconds();
 
   nlohmann::ordered_json& seconds = stats["seconds"];

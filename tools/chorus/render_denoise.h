@@ -75,9 +75,11 @@ struct DenoiseStage {
   // writes files() to `dir` (denoised.png and, unless a preview, denoised.exr; weights.exr and
   // <member>.exr with --keep), and adds every stage's seconds to stats["seconds"] and, with a
   // reference, the metrics of the noisy input, each member and the result to stats["metrics"].
-  // Returns the seconds of the members and the combiner (without writing).
+  // Returns the seconds of the members and the combiner (without writing). Each member run's end
+  // goes to `progress`.
   double run(const EnsembleSources& sources, const std::filesystem::path& dir,
-             nlohmann::ordered_json& stats, const Image* reference) const;
+             nlohmann::ordered_json& stats, const Image* reference,
+             const RunsProgressCallback& progress = {}) const;
 };
 
 }  // namespace chorus::cli

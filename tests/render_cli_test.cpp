@@ -274,7 +274,8 @@ TEST(RenderCli, DenoisesInProcessLikeChorusDenoiseOnTheWrittenRender) {
 }
 
 // Render now, denoise later: --denoise none keeps the 4 sub-buffers the default members need, so
-// `chorus denoise` on render.exr computes exactly what the render's own default denoising does.
+// `chorus denoise --methods default` on render.exr computes exactly what the render's own default
+// denoising does.
 // --splits 1 keeps one, which feeds the members that need no halves, alone.
 TEST(RenderCli, RenderNowDenoiseLaterWithTheDefaultMembers) {
   TempDir dir;
@@ -290,12 +291,14 @@ TEST(RenderCli, RenderNowDenoiseLaterWithTheDefaultMembers) {
   auto r = render({"--denoise", "none", "--out", later.string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_EQ(readJson(later / "stats.json")["splits"], 4);
-  r = runChorus({"denoise", (later / "render.exr").string(), "--methods", "nfor,rdfc,atrous",
-                 "--out", (dir / "denoised").string()});
+  r = runChorus({"denoise", (later / "render.exr").string(), "--methods", "default", "--out",
+                 (dir / "denoised").string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   r = render({"--out", now.string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
-  EXPECT_EQ(readJson(now / "stats.json")["denoise"]["methods"], json({"nfor", "rdfc", "atrous"}));
+  const json defaults = {"nfor", "rdfc", "atrous"};
+  EXPECT_EQ(readJson(now / "stats.json")["denoise"]["methods"], defaults);
+  EXPECT_EQ(readJson(dir / "denoised" / "stats.json")["methods"], defaults);
   const Image inRender = readExrLayer(now / "denoised.exr");
   const Image fromFile = readExrLayer(dir / "denoised" / "ensemble.exr");
   ASSERT_TRUE(inRender.sameSize(fromFile));

@@ -36,6 +36,7 @@
 #include "tools/chorus/flag_checks.h"
 #include "tools/chorus/kept_outputs.h"
 #include "tools/chorus/progress_bar.h"
+#include "tools/chorus/render_denoise.h"
 
 namespace chorus::cli {
 namespace {
@@ -223,7 +224,8 @@ void writeStats(const DenoiseArgs& args, Json& stats, Json& times, const Stopwat
 
 void runDenoise(const DenoiseArgs& args) {
   const Stopwatch total;
-  const std::vector<std::string> specs = splitMethodList(args.methods);
+  const std::vector<std::string> specs =
+      splitMethodList(args.methods == "default" ? kDefaultDenoise : args.methods);
   const std::vector<Combiner> combiners = combinersOf(args.combine, specs.size());
   const CombineOptions options = args.ensemble.options();
   const fs::path out = args.out;
@@ -350,7 +352,8 @@ const RegisterCommand denoiseCommand(40, [](CLI::App& app) {
       ->required();
   cmd->add_option("--methods", args->methods,
                   "Comma-separated base denoisers: built-in specs (name or name:key=value) for a "
-                  "render.exr or Tungsten directory, folder names for a directory of outputs")
+                  "render.exr or Tungsten directory (default: chorus render's default members), "
+                  "folder names for a directory of outputs")
       ->required();
   cmd->add_option("--out", args->out, "Output directory")->required()->transform(pathName());
   cmd->add_option("--combine", args->combine,

@@ -17,8 +17,9 @@
 
 namespace chorus::cli {
 
-// The members `chorus render` uses when --denoise is not given, and with --preview (README,
-// "Choosing the default members": the sweep evidence behind both).
+// The members `chorus render` uses when --denoise is not given (and `chorus denoise --methods
+// default`), and with --preview (README, "Choosing the default members": the sweep evidence
+// behind both).
 inline constexpr const char* kDefaultDenoise = "nfor,rdfc,atrous";
 // The previews' members spread an unconfirmed outlier's excess over a radius of 12 instead of 6
 // (the guard's spread=R): at 4 samples per pixel a caustic's one bright sample is a poor guide to

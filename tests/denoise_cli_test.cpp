@@ -301,6 +301,11 @@ TEST(DenoiseCli, MembersAloneOnAOneSubBufferRender) {
                            "render without --splits 1"})
     EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(bad));
+  // A member listed twice: that alone, not a hint about the input.
+  r = runChorus({"denoise", render.string(), "--methods", "atrous,atrous", "--out", bad.string()});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(r.err, "chorus: base denoiser 'atrous' is listed twice\n");
+  EXPECT_FALSE(fs::exists(bad));
 }
 
 // NFOR, RDFC and dual-buffer NL-means alone on a K = 2 render (the full buffer's two halves);

@@ -189,6 +189,8 @@ TEST(RenderCli, FailsCleanlyOnBadInput) {
                      out);
   expectCleanFailure({"render", scene.string(), "--denoise", "atrous,foo", "--out", o},
                      "unknown denoiser 'foo'", out);
+  expectCleanFailure({"render", scene.string(), "--denoise", "atrous,atrous", "--out", o},
+                     "base denoiser 'atrous' is listed twice", out);  // before the render
   expectCleanFailure({"render", scene.string(), "--denoise", "jnlm:k=x", "--out", o},
                      "denoiser jnlm: parameter k=x is not a finite number", out);
   expectCleanFailure({"render", scene.string(), "--denoise", "nlm:alpha=nan", "--out", o},

@@ -16,11 +16,22 @@
 #include "denoise/pipeline/member_runner.h"
 
 namespace chorus {
+namespace {
+
+void rejectRepeatedLabels(std::span<const EnsembleMember> members) {
+  std::set<std::string> labels;
+  for (const EnsembleMember& member : members)
+    if (!labels.insert(member.label).second)
+      throw Error("base denoiser '" + member.label + "' is listed twice");
+}
+
+}  // namespace
 
 std::vector<EnsembleMember> membersFromSpecs(std::span<const std::string> specs) {
   std::vector<EnsembleMember> members;
   for (const std::string& spec : specs)
     members.push_back({spec, std::shared_ptr<const BaseDenoiser>(createDenoiser(spec))});
+  rejectRepeatedLabels(members);  // before any input is read or rendered
   return members;
 }
 
@@ -29,10 +40,7 @@ namespace {
 // Members with distinct labels (their outputs' file and layer names), at least one.
 void checkLabels(std::span<const EnsembleMember> members) {
   if (members.empty()) throw Error("no base denoisers given");
-  std::set<std::string> labels;
-  for (const EnsembleMember& member : members)
-    if (!labels.insert(member.label).second)
-      throw Error("base denoiser '" + member.label + "' is listed twice");
+  rejectRepeatedLabels(members);
 }
 
 bool needsHalves(const EnsembleMember& member) {

@@ -25,7 +25,7 @@ struct EnsembleMember {
 };
 
 // One member per registry spec ("nfor", "jnlm:k=0.4"), labelled with the spec. Throws
-// chorus::Error for an unknown name or parameter (denoise/base/registry.h).
+// chorus::Error for an unknown name or parameter (denoise/base/registry.h) or a spec listed twice.
 std::vector<EnsembleMember> membersFromSpecs(std::span<const std::string> specs);
 
 // Progress of the member runs, for a command's progress display: called with done = 0 before

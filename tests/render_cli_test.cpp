@@ -165,6 +165,37 @@ TEST(RenderCli, QuietPrintsNothingAndNoLightsGetsOneLine) {
   EXPECT_EQ(r.err.find("no lights"), std::string::npos) << r.err;
 }
 
+// Below K samples per pixel some sub-buffers stay empty: one warning line (stderr, unless
+// --quiet, and stats.json); from K spp on, or without denoising, none.
+TEST(RenderCli, WarnsWhenSubBuffersGetNoSamples) {
+  TempDir dir;
+  const auto scene = writeLitScene(dir);
+  const auto run = [&](const std::string& spp, const std::string& denoise, const char* name,
+                       bool quiet) {
+    std::vector<std::string> args = {
+        "render", scene.string(),       "--spp", spp,         "--width",
+        "8",      "--height",           "8",     "--denoise", denoise,
+        "--out",  (dir / name).string()};
+    if (quiet) args.push_back("--quiet");
+    const auto r = runChorus(args);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    return std::make_pair(r.err, readJson(dir / name / "stats.json")["warnings"]);
+  };
+  const std::string warning =
+      "1 of the 2 sub-buffers get no samples at 1 spp, and the members run on them too: render at "
+      "least 2 spp";
+  auto [err, warnings] = run("1", "atrous", "one", false);
+  EXPECT_NE(err.find("chorus: warning: " + warning + "\n"), std::string::npos) << err;
+  EXPECT_EQ(warnings, json({warning}));
+  std::tie(err, warnings) = run("1", "atrous", "quiet", true);
+  EXPECT_EQ(err, "");
+  EXPECT_EQ(warnings, json({warning}));
+  std::tie(err, warnings) = run("2", "atrous", "two", true);
+  EXPECT_EQ(warnings, json::array());
+  std::tie(err, warnings) = run("1", "none", "none", true);  // K = 4, for a later denoise
+  EXPECT_EQ(warnings, json::array());
+}
+
 void expectCleanFailure(const std::vector<std::string>& args, const std::string& fragment,
                         const std::filesystem::path& out) {
   const auto r = runChorus(args);

@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "tests/support/denoiser_checks.h"
 #include "tests/support/gaussian_buffers.h"
 
 namespace chorus {
@@ -68,6 +69,33 @@ TEST(VarianceEstimates, OneSampleWholeKeepsARoughEstimate) {
   }
   // Two one-sample halves of variance σ² each: E[(x1 − x2)² / 4] = σ² / 2.
   EXPECT_NEAR(meanOf(whole) / (kSigma * kSigma), 0.5, 0.03);
+}
+
+// One-sample pixels (a 1-spp render) record variance 0; the spatial estimate, the squared MAD of
+// their 5x5 neighbourhood, recovers the per-sample variance σ² of i.i.d. Gaussian noise (it is
+// consistent, not unbiased: the median of 25 deviations; four seeds average 4096 pixels each).
+// Pixels with 2 samples or more keep their own variance bit for bit; without counts nothing
+// changes.
+TEST(VarianceEstimates, OneSamplePixelsGetTheirNeighbourhoodsSpread) {
+  double ratio = 0;
+  constexpr int kSeeds = 4;
+  for (unsigned seed = 1; seed <= kSeeds; ++seed) {
+    const DenoiseInput input = halvesOf(1, 2, seed);
+    const SubBuffer& one = (*input.halves)[0];
+    ASSERT_EQ(meanOf(one.color.varianceOfMean), 0.0);
+    ratio += meanOf(spatialVarianceWhereOneSample(one, Quantity::Color, one.color.varianceOfMean)) /
+             (kSigma * kSigma) / kSeeds;
+    const SubBuffer& two = (*input.halves)[1];
+    EXPECT_TRUE(test::bitIdentical(
+        spatialVarianceWhereOneSample(two, Quantity::Color, two.color.varianceOfMean),
+        two.color.varianceOfMean));
+    SubBuffer uncounted = one;
+    uncounted.sampleCount = Image();
+    EXPECT_TRUE(test::bitIdentical(
+        spatialVarianceWhereOneSample(uncounted, Quantity::Color, one.color.varianceOfMean),
+        one.color.varianceOfMean));
+  }
+  EXPECT_NEAR(ratio, 1.0, 0.1);
 }
 
 }  // namespace

@@ -1,8 +1,11 @@
 #include "denoise/base/variance_estimates.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
+#include <vector>
 
 #include "denoise/base/filters/box_filter.h"
 
@@ -79,6 +82,42 @@ Image halfVarianceOfMean(const DenoiseInput& input, int which, Quantity q) {
       which == 0 ? TwoBufferTarget::FirstHalf : TwoBufferTarget::SecondHalf;
   return withFallback(half.get(q).varianceOfMean, half.sampleCount,
                       twoBufferVariance(halves[0], halves[1], q, target));
+}
+
+Image spatialVarianceWhereOneSample(const SubBuffer& buffer, Quantity q, const Image& variance) {
+  const Image& mean = buffer.get(q).mean;
+  const Image& count = buffer.sampleCount;
+  if (!count.sameSize(mean)) return variance;
+  const int w = mean.width(), h = mean.height(), r = kVarianceFallbackRadius;
+  constexpr double kMadToSigma = 1.4826;  // σ of a normal distribution per median |deviation|
+  Image spread(w, h, mean.channels());
+  std::vector<float> values;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float n = count(x, y, 0);
+      if (!(n > 0.0f && n < 2.0f)) continue;  // withFallback keeps `variance` there
+      for (int c = 0; c < mean.channels(); ++c) {
+        values.clear();
+        for (int qy = std::max(0, y - r); qy <= std::min(h - 1, y + r); ++qy)
+          for (int qx = std::max(0, x - r); qx <= std::min(w - 1, x + r); ++qx) {
+            const float v = mean(qx, qy, c);
+            if (count(qx, qy, 0) > 0.0f && std::isfinite(v)) values.push_back(v);
+          }
+        if (values.size() < 2) {
+          spread(x, y, c) = 0.0f;
+          continue;
+        }
+        const auto middle = values.begin() + std::ptrdiff_t(values.size() / 2);
+        std::nth_element(values.begin(), middle, values.end());
+        const float median = *middle;
+        for (float& v : values) v = std::abs(v - median);
+        std::nth_element(values.begin(), middle, values.end());
+        const double sigma = kMadToSigma * double(*middle);
+        spread(x, y, c) =
+            float(std::min(sigma * sigma / n, double(std::numeric_limits<float>::max())));
+      }
+    }
+  return withFallback(variance, count, spread);
 }
 
 }  // namespace chorus

@@ -38,4 +38,11 @@ Image wholeVarianceOfMean(const DenoiseInput& input, Quantity q);
 // smoothed two-buffer estimate.
 Image halfVarianceOfMean(const DenoiseInput& input, int which, Quantity q);
 
+// `variance` (of buffer's quantity q) where a pixel has 2 samples or more; where it has one
+// (a 1-spp render: variance 0 recorded, nothing to compare it with), the spread of the one-sample
+// means within kVarianceFallbackRadius (their unbiased sample variance, SVGF's spatial estimate):
+// the noise of one sample plus the signal's own variation there, an overestimate at edges, where
+// a feature-guided filter stops anyway. `variance` itself without sample counts.
+Image spatialVarianceWhereOneSample(const SubBuffer& buffer, Quantity q, const Image& variance);
+
 }  // namespace chorus

@@ -17,6 +17,7 @@
 #include "denoise/base/input_planes.h"
 #include "denoise/base/selection_knee.h"
 #include "denoise/base/variance_calibration.h"
+#include "denoise/base/variance_estimates.h"
 #include "denoise/planes/padded_planes.h"
 #include "denoise/util/simd_clones.h"
 
@@ -447,9 +448,13 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& given, AtrousKernel
 }
 
 Image Atrous::run(const DenoiseInput& input) const {
-  const Image variance = calibratedWholeColorVariance(input, params_.calibrationRadius);
-  return runAtrous(input.whole, params_, AtrousKernelPath::Widest, input.sampleShare,
-                   variance.empty() ? nullptr : &variance);
+  const Image calibrated = calibratedWholeColorVariance(input, params_.calibrationRadius);
+  // One-sample pixels (1 spp) record variance 0, which would stop the luminance weight at every
+  // difference: there the spread of their neighbourhood instead.
+  const Image variance = spatialVarianceWhereOneSample(
+      input.whole, Quantity::Color,
+      calibrated.empty() ? input.whole.color.varianceOfMean : calibrated);
+  return runAtrous(input.whole, params_, AtrousKernelPath::Widest, input.sampleShare, &variance);
 }
 
 }  // namespace chorus

@@ -39,10 +39,12 @@ Image wholeVarianceOfMean(const DenoiseInput& input, Quantity q);
 Image halfVarianceOfMean(const DenoiseInput& input, int which, Quantity q);
 
 // `variance` (of buffer's quantity q) where a pixel has 2 samples or more; where it has one
-// (a 1-spp render: variance 0 recorded, nothing to compare it with), the spread of the one-sample
-// means within kVarianceFallbackRadius (their unbiased sample variance, SVGF's spatial estimate):
-// the noise of one sample plus the signal's own variation there, an overestimate at edges, where
-// a feature-guided filter stops anyway. `variance` itself without sample counts.
+// (a 1-spp render: variance 0 recorded, nothing to compare it with), the spread of the sampled
+// means within kVarianceFallbackRadius, (1.4826 × their median absolute deviation)²: SVGF's
+// spatial estimate, made robust so that a dark neighbourhood's few bright samples do not widen
+// it (docs/members/sbf-atrous-bilateral.md). It holds the signal's own variation too, an
+// overestimate at edges, where a feature-guided filter stops anyway. `variance` itself without
+// sample counts.
 Image spatialVarianceWhereOneSample(const SubBuffer& buffer, Quantity q, const Image& variance);
 
 }  // namespace chorus

@@ -5,9 +5,9 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
-#include <vector>
 
 #include "denoise/base/filters/box_filter.h"
+#include "denoise/util/parallel_rows.h"
 
 namespace chorus {
 namespace {
@@ -88,35 +88,38 @@ Image spatialVarianceWhereOneSample(const SubBuffer& buffer, Quantity q, const I
   const Image& mean = buffer.get(q).mean;
   const Image& count = buffer.sampleCount;
   if (!count.sameSize(mean)) return variance;
-  const int w = mean.width(), h = mean.height(), r = kVarianceFallbackRadius;
+  const int w = mean.width(), h = mean.height(), r = kSpatialVarianceRadius;
+  constexpr int kTaps = (2 * kSpatialVarianceRadius + 1) * (2 * kSpatialVarianceRadius + 1);
   constexpr double kMadToSigma = 1.4826;  // σ of a normal distribution per median |deviation|
   Image spread(w, h, mean.channels());
-  std::vector<float> values;
-  for (int y = 0; y < h; ++y)
+  parallelRows(0, h, [&](int y) {
+    std::array<float, kTaps> values;
     for (int x = 0; x < w; ++x) {
       const float n = count(x, y, 0);
       if (!(n > 0.0f && n < 2.0f)) continue;  // withFallback keeps `variance` there
       for (int c = 0; c < mean.channels(); ++c) {
-        values.clear();
+        int taken = 0;
         for (int qy = std::max(0, y - r); qy <= std::min(h - 1, y + r); ++qy)
           for (int qx = std::max(0, x - r); qx <= std::min(w - 1, x + r); ++qx) {
             const float v = mean(qx, qy, c);
-            if (count(qx, qy, 0) > 0.0f && std::isfinite(v)) values.push_back(v);
+            if (count(qx, qy, 0) > 0.0f && std::isfinite(v)) values[size_t(taken++)] = v;
           }
-        if (values.size() < 2) {
+        if (taken < 2) {
           spread(x, y, c) = 0.0f;
           continue;
         }
-        const auto middle = values.begin() + std::ptrdiff_t(values.size() / 2);
-        std::nth_element(values.begin(), middle, values.end());
+        float* const first = values.data();
+        float* const middle = first + taken / 2;
+        std::nth_element(first, middle, first + taken);
         const float median = *middle;
-        for (float& v : values) v = std::abs(v - median);
-        std::nth_element(values.begin(), middle, values.end());
+        for (int i = 0; i < taken; ++i) values[size_t(i)] = std::abs(values[size_t(i)] - median);
+        std::nth_element(first, middle, first + taken);
         const double sigma = kMadToSigma * double(*middle);
         spread(x, y, c) =
             float(std::min(sigma * sigma / n, double(std::numeric_limits<float>::max())));
       }
     }
+  });
   return withFallback(variance, count, spread);
 }
 

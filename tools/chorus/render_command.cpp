@@ -63,7 +63,7 @@ DenoiseStage denoiseStageOf(const RenderArgs& args) {
 // Sample i of a pixel goes to sub-buffer i mod K: below K samples per pixel some sub-buffers
 // stay empty, and the members' runs on them (and the estimate that compares them) have nothing to
 // work with (Cornell box 64², default members: NFOR 3.1x worse than the noisy input at 2 spp, the
-// blend 0.143 against the preview's 0.064). Empty when the run denoises at K spp or more.
+// blend 0.141 against the preview's 0.063). Empty when the run denoises at K spp or more.
 std::string fewSamplesWarning(const DenoiseStage& denoise, const RenderOptions& options) {
   if (!denoise.enabled() || options.spp >= options.splits) return {};
   const int empty = options.splits - options.spp;

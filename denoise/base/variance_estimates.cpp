@@ -87,7 +87,11 @@ Image halfVarianceOfMean(const DenoiseInput& input, int which, Quantity q) {
 Image spatialVarianceWhereOneSample(const SubBuffer& buffer, Quantity q, const Image& variance) {
   const Image& mean = buffer.get(q).mean;
   const Image& count = buffer.sampleCount;
-  if (!count.sameSize(mean)) return variance;
+  // Without one-sample pixels (every run from 4 spp on) this costs one scan of the counts.
+  const auto oneSample = [](float n) { return n > 0.0f && n < 2.0f; };
+  if (!count.sameSize(mean) ||
+      std::none_of(count.values().begin(), count.values().end(), oneSample))
+    return variance;
   const int w = mean.width(), h = mean.height(), r = kSpatialVarianceRadius;
   constexpr int kTaps = (2 * kSpatialVarianceRadius + 1) * (2 * kSpatialVarianceRadius + 1);
   constexpr double kMadToSigma = 1.4826;  // σ of a normal distribution per median |deviation|
@@ -96,7 +100,7 @@ Image spatialVarianceWhereOneSample(const SubBuffer& buffer, Quantity q, const I
     std::array<float, kTaps> values;
     for (int x = 0; x < w; ++x) {
       const float n = count(x, y, 0);
-      if (!(n > 0.0f && n < 2.0f)) continue;  // withFallback keeps `variance` there
+      if (!oneSample(n)) continue;  // withFallback keeps `variance` there
       for (int c = 0; c < mean.channels(); ++c) {
         int taken = 0;
         for (int qy = std::max(0, y - r); qy <= std::min(h - 1, y + r); ++qy)

@@ -16,6 +16,19 @@ std::string bar(double fraction, int width) {
   return std::string(size_t(filled), '#') + std::string(size_t(width - filled), '-');
 }
 
+std::string runsProgressText(const RunsProgress& p, double elapsedSeconds) {
+  const double fraction = p.total > 0 ? double(p.done) / double(p.total) : 1.0;
+  char text[256];
+  std::snprintf(text, sizeof text, "denoising [%s] %2zu/%zu member runs, %.1f s",
+                bar(fraction, kBarWidth).c_str(), p.done, p.total, elapsedSeconds);
+  std::string line = text;
+  if (!p.finished.empty()) {
+    std::snprintf(text, sizeof text, " (%s took %.1f s)", p.finished.c_str(), p.seconds);
+    line += text;
+  }
+  return line;
+}
+
 }  // namespace
 
 bool TerminalLine::stderrIsTerminal() {
@@ -46,19 +59,6 @@ void ProgressBar::update(const render::RenderProgress& p) {
   std::snprintf(text, sizeof text, "[%s] %5.1f%%  %6.2f M samples/s  ETA %5.1f s",
                 bar(fraction, kBarWidth).c_str(), 100.0 * fraction, rate / 1e6, eta);
   line_.draw(text, p.samplesDone >= p.samplesTotal);
-}
-
-std::string runsProgressText(const RunsProgress& p, double elapsedSeconds) {
-  const double fraction = p.total > 0 ? double(p.done) / double(p.total) : 1.0;
-  char text[256];
-  std::snprintf(text, sizeof text, "denoising [%s] %2zu/%zu member runs, %.1f s",
-                bar(fraction, kBarWidth).c_str(), p.done, p.total, elapsedSeconds);
-  std::string line = text;
-  if (!p.finished.empty()) {
-    std::snprintf(text, sizeof text, " (%s took %.1f s)", p.finished.c_str(), p.seconds);
-    line += text;
-  }
-  return line;
 }
 
 RunsProgressCallback RunsProgressLine::callback() {

@@ -43,8 +43,6 @@ class ProgressBar {
 };
 
 // "denoising [####------]  5/12 member runs, 21.4 s (nfor/without-q1 took 8.3 s)"
-std::string runsProgressText(const RunsProgress& p, double elapsedSeconds);
-
 class RunsProgressLine {
  public:
   explicit RunsProgressLine(bool enabled) : line_(enabled) {}

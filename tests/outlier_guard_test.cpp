@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "denoise/base/outlier_guard.h"
@@ -290,6 +291,39 @@ TEST(OutlierGuard, TheWholeIsTheMergeOfTheGuardedHalves) {
   EXPECT_LT(g.input.whole.color.mean(7, 7, 0), 10.0f);
   // The other half is judged on its own neighbourhood: untouched.
   EXPECT_EQ((*g.input.halves)[1].color.mean(7, 7, 0), h1.color.mean(7, 7, 0));
+}
+
+// The ceiling's second term, highFactor (4) × Q, with Q the value exceeded by only a twelfth of
+// the neighbours (rank (2r + 1)² − 1) / 12 from the top): around a firefly whose own samples
+// do not confirm it (one sample of 4x among four zeros, mean x), every neighbour reads 1 but
+// `bright` of them read 10. With rank + 1 bright neighbours Q is 10 and the ceiling 40, with
+// rank of them Q is 1 and the ceiling 4; the firefly of 39 is clamped only in the second case,
+// one of 41 in both. At every radius the guard takes (each keeps its own length of list).
+TEST(OutlierGuard, TheCeilingFollowsTheNeighbourhoodsTwelfthLargestAtEveryRadius) {
+  for (int radius = 1; radius <= 4; ++radius) {
+    const int rank = ((2 * radius + 1) * (2 * radius + 1) - 1) / 12;
+    for (int bright : {rank, rank + 1})
+      for (double firefly : {39.0, 41.0}) {
+        const int c = 10;
+        const SubBuffer s = fromSamples(21, 21, [&](int x, int y) {
+          if (x == c && y == c) return std::vector<double>{4 * firefly, 0, 0, 0};
+          // The first `bright` neighbours in the window's top row.
+          if (y == c - radius && x - (c - radius) < bright && x >= c - radius)
+            return std::vector<double>{10, 10, 10, 10};
+          return std::vector<double>{1, 1, 1, 1};
+        });
+        OutlierGuardOptions options;
+        options.radius = radius;
+        const float out = guardOutliers(wholeOnly(s), options).input.whole.color.mean(c, c, 0);
+        const bool clamped = firefly > (bright > rank ? 40.0 : 4.0);
+        SCOPED_TRACE("radius " + std::to_string(radius) + ", bright " + std::to_string(bright) +
+                     ", firefly " + std::to_string(firefly));
+        if (clamped)
+          EXPECT_LT(out, 4.0f);
+        else
+          EXPECT_EQ(out, float(firefly));
+      }
+  }
 }
 
 TEST(OutlierGuard, GuardZeroIsOff) {

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <numbers>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "denoise/util/parallel_rows.h"
+#include "denoise/util/simd_clones.h"
 
 namespace chorus {
 namespace {
@@ -114,6 +116,85 @@ float largest(const float* values, int count, int rank) {
   return top[size_t(rank)];
 }
 
+// Per pixel x of a row, over its (2 r + 1)² − 1 neighbours in `rows` (2 r + 1 rows of one
+// channel, `padded` apart, with r NaN columns on the left and NaN up to a whole number of
+// blocks and r more on the right): how many are finite, how many are below the pixel, and the
+// `tops` largest in descending order (largest[k · blocks · kBlock + x]; exact only where every
+// neighbour is finite, which is where it is read).
+constexpr int kBlock = 16;
+struct NeighbourRanks {
+  NeighbourRanks(int width, int radius, int tops)
+      : blocks((width + kBlock - 1) / kBlock),
+        padded(size_t(blocks * kBlock + 2 * radius)),
+        tops(tops),
+        rows(size_t(2 * radius + 1) * padded, std::numeric_limits<float>::quiet_NaN()),
+        count(size_t(blocks * kBlock)),
+        below(size_t(blocks * kBlock)),
+        largest(size_t(blocks * kBlock) * size_t(tops)) {}
+  int blocks;
+  size_t padded;
+  int tops;
+  std::vector<float> rows;
+  std::vector<int> count, below;
+  std::vector<float> largest;
+};
+
+// Eight pixels at a time in GCC vector types (each clone picks its instructions), their running
+// counts and lists in registers (written as plain loops, the lists became masked stores).
+using FloatLanes = float __attribute__((vector_size(32)));
+using IntLanes = int __attribute__((vector_size(32)));
+static_assert(kBlock % 8 == 0);
+
+template <int kTops>
+CHORUS_SIMD_CLONES_EXACT void rankNeighboursOf(const float* rows, size_t padded, int r, int blocks,
+                                               int* count, int* below, float* largest) {
+  const size_t stride = size_t(blocks) * kBlock;
+  for (size_t x0 = 0; x0 < stride; x0 += 8) {
+    FloatLanes centre;
+    std::memcpy(&centre, rows + size_t(r) * padded + size_t(r) + x0, sizeof centre);
+    IntLanes finite = {}, lower = {};
+    FloatLanes top[kTops];
+    for (int k = 0; k < kTops; ++k) top[k] = FloatLanes{} - std::numeric_limits<float>::infinity();
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx) {
+        if (dx == 0 && dy == 0) continue;
+        FloatLanes v;
+        std::memcpy(&v, rows + size_t(dy + r) * padded + size_t(r + dx) + x0, sizeof v);
+        finite -= (v - v == 0.0f);  // comparisons give −1 where true
+        lower -= (v < centre);
+        for (int k = 0; k < kTops; ++k) {  // insert v into the descending list
+          const IntLanes greater = top[k] > v;
+          const FloatLanes t = top[k];
+          top[k] = greater ? t : v;
+          v = greater ? v : t;
+        }
+      }
+    std::memcpy(count + x0, &finite, sizeof finite);
+    std::memcpy(below + x0, &lower, sizeof lower);
+    for (int k = 0; k < kTops; ++k)
+      std::memcpy(largest + size_t(k) * stride + x0, &top[k], sizeof top[k]);
+  }
+}
+
+void rankNeighbours(int r, NeighbourRanks& ranks) {
+  const float* rows = ranks.rows.data();
+  int* count = ranks.count.data();
+  int* below = ranks.below.data();
+  float* largest = ranks.largest.data();
+  switch (ranks.tops) {
+    case 1:
+      return rankNeighboursOf<1>(rows, ranks.padded, r, ranks.blocks, count, below, largest);
+    case 3:
+      return rankNeighboursOf<3>(rows, ranks.padded, r, ranks.blocks, count, below, largest);
+    case 5:
+      return rankNeighboursOf<5>(rows, ranks.padded, r, ranks.blocks, count, below, largest);
+    case 7:
+      return rankNeighboursOf<7>(rows, ranks.padded, r, ranks.blocks, count, below, largest);
+    default:
+      throw std::logic_error("rankNeighbours: unexpected rank");
+  }
+}
+
 class PartGuard {
  public:
   PartGuard(const SubBuffer& part, const SubBuffer* other, const OutlierGuardOptions& options)
@@ -128,10 +209,10 @@ class PartGuard {
     parallelRows(0, h, [&](int y) {
       rowCounts[size_t(y)] = guardRow(y, out, changed, rowExcess[size_t(y)]);
     });
-    // In raster order, so that the sums do not depend on the thread count.
-    SpreadKernels kernels;
-    for (const std::vector<Excess>& excesses : rowExcess)
-      for (const Excess& excess : excesses) spread(excess, kernels, out, changed);
+    std::vector<Excess> excesses;
+    for (const std::vector<Excess>& row : rowExcess)
+      excesses.insert(excesses.end(), row.begin(), row.end());
+    spreadAll(excesses, out, changed);
     return std::accumulate(rowCounts.begin(), rowCounts.end(), size_t(0));
   }
 
@@ -158,7 +239,7 @@ class PartGuard {
   }
 
   // The Gaussians g of spread by radius, g(dx, dy) at |dy| (r + 1) + |dx|: computed once per
-  // radius instead of twice per pixel of every window (the spread is the guard's serial part).
+  // radius instead of twice per pixel of every window.
   struct SpreadKernels {
     std::array<std::vector<double>, kMaxGuardSpread + 1> byRadius;
     const std::vector<double>& of(int r) {
@@ -180,67 +261,80 @@ class PartGuard {
   // edges a box would draw. The share that falls on other surfaces is dropped, not given to the
   // outlier's surface: on a thin one (a lamp's arm, a few pixels wide) that concentrated an
   // excess of the whole window onto a handful of pixels (0.96 where the reference is 0.004).
-  void spread(const Excess& e, SpreadKernels& kernels, MeanVariance& out,
-              std::vector<uint8_t>& changed) const {
-    const int w = part_.width(), h = part_.height(), r = e.radius;
-    const int x0 = std::max(0, e.x - r), x1 = std::min(w - 1, e.x + r);
-    const int y0 = std::max(0, e.y - r), y1 = std::min(h - 1, e.y + r);
+  // `excesses` in raster order. Rows in parallel, each adding its excesses in that order, so
+  // that every pixel's sum is the same whatever the thread count.
+  void spreadAll(const std::vector<Excess>& excesses, MeanVariance& out,
+                 std::vector<uint8_t>& changed) const {
+    if (excesses.empty()) return;
+    const int w = part_.width(), h = part_.height();
+    SpreadKernels kernels;
+    for (const Excess& e : excesses) kernels.of(e.radius);
+    // Σ g over each window's part inside the image.
+    std::vector<double> totals(excesses.size());
+    parallelChunks(excesses.size(), [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) {
+        const Excess& e = excesses[i];
+        const std::vector<double>& g = kernels.byRadius[size_t(e.radius)];
+        double total = 0;
+        for (int y = std::max(0, e.y - e.radius); y <= std::min(h - 1, e.y + e.radius); ++y)
+          for (int x = std::max(0, e.x - e.radius); x <= std::min(w - 1, e.x + e.radius); ++x)
+            total += g[size_t(std::abs(y - e.y) * (e.radius + 1) + std::abs(x - e.x))];
+        totals[i] = total;
+      }
+    });
     const Image& depth = part_.depth.mean;
     const bool hasDepth = depth.sameSize(part_.color.mean);
-    const double here = hasDepth ? depth(e.x, e.y, 0) : 0.0;
-    const std::vector<double>& g = kernels.of(r);
-    auto gaussian = [&](int x, int y) {
-      return g[size_t(std::abs(y - e.y) * (r + 1) + std::abs(x - e.x))];
-    };
-    double total = 0;
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) total += gaussian(x, y);
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) {
-        const double share =
-            gaussian(x, y) * (hasDepth ? sameSurface(here, depth(x, y, 0)) : 1.0) / total;
-        float& m = out.mean(x, y, e.c);
-        m = float(std::min(double(m) + e.amount * share, double(kMaxFloat)));
-        changed[size_t(y) * size_t(w) + size_t(x)] = 1;
+    parallelRows(0, h, [&](int y) {
+      // The excesses whose windows can reach row y: e.y within kMaxGuardSpread of it.
+      auto first = std::lower_bound(excesses.begin(), excesses.end(), y - kMaxGuardSpread,
+                                    [](const Excess& e, int row) { return e.y < row; });
+      for (auto it = first; it != excesses.end() && it->y <= y + kMaxGuardSpread; ++it) {
+        const Excess& e = *it;
+        const int r = e.radius, dy = std::abs(y - e.y);
+        if (dy > r) continue;
+        const std::vector<double>& g = kernels.byRadius[size_t(r)];
+        const double here = hasDepth ? depth(e.x, e.y, 0) : 0.0;
+        const double total = totals[size_t(it - excesses.begin())];
+        for (int x = std::max(0, e.x - r); x <= std::min(w - 1, e.x + r); ++x) {
+          const double share = g[size_t(dy * (r + 1) + std::abs(x - e.x))] *
+                               (hasDepth ? sameSurface(here, depth(x, y, 0)) : 1.0) / total;
+          float& m = out.mean(x, y, e.c);
+          m = float(std::min(double(m) + e.amount * share, double(kMaxFloat)));
+          changed[size_t(y) * size_t(w) + size_t(x)] = 1;
+        }
       }
+    });
   }
 
   // Per channel, 1 at the pixels of row y that can be outliers: a finite value with at least
-  // kMinNeighbours finite neighbours, at most a twelfth of which reach it (the first test of
-  // guardRow, for whole rows at once: most pixels stop here). Neighbours outside the image
-  // read as NaN padding, which is neither finite nor below anything.
+  // kMinNeighbours finite neighbours, at most a twelfth of which reach it, and where every
+  // neighbour is finite, above highFactor · Q (the first two tests of guardRow, for whole rows
+  // at once: most pixels stop here). Neighbours outside the image read as NaN padding, which is
+  // neither finite nor below anything.
   std::array<std::vector<uint8_t>, 3> candidatesOfRow(int y) const {
     const Image& mean = part_.color.mean;
     const int w = mean.width(), h = mean.height(), r = o_.radius;
-    const size_t padded = size_t(w + 2 * r);
-    std::vector<float> rows(size_t(2 * r + 1) * padded, std::numeric_limits<float>::quiet_NaN());
-    std::vector<int> count(static_cast<size_t>(w)), below(static_cast<size_t>(w));
+    const int full = (2 * r + 1) * (2 * r + 1) - 1, highRank = full / 12;
+    NeighbourRanks ranks(w, r, highRank + 1);
     std::array<std::vector<uint8_t>, 3> out;
     for (int c = 0; c < 3; ++c) {
       for (int dy = -r; dy <= r; ++dy) {
         if (y + dy < 0 || y + dy >= h) continue;
-        float* row = rows.data() + size_t(dy + r) * padded + size_t(r);
+        float* row = ranks.rows.data() + size_t(dy + r) * ranks.padded + size_t(r);
         for (int x = 0; x < w; ++x) row[x] = mean(x, y + dy, c);
       }
-      const float* centre = rows.data() + size_t(r) * padded + size_t(r);
-      std::fill(count.begin(), count.end(), 0);
-      std::fill(below.begin(), below.end(), 0);
-      for (int dy = -r; dy <= r; ++dy) {
-        if (y + dy < 0 || y + dy >= h) continue;
-        for (int dx = -r; dx <= r; ++dx) {
-          if (dx == 0 && dy == 0) continue;
-          const float* q = rows.data() + size_t(dy + r) * padded + size_t(r + dx);
-          for (int x = 0; x < w; ++x) {
-            count[size_t(x)] += q[x] - q[x] == 0.0f;  // finite
-            below[size_t(x)] += q[x] < centre[x];
-          }
-        }
-      }
+      rankNeighbours(r, ranks);
+      const float* centre = ranks.rows.data() + size_t(r) * ranks.padded + size_t(r);
+      const float* high = ranks.largest.data() + size_t(highRank) * size_t(ranks.blocks * kBlock);
       out[size_t(c)].resize(size_t(w));
       for (int x = 0; x < w; ++x) {
-        const int n = count[size_t(x)];
-        out[size_t(c)][size_t(x)] =
-            std::isfinite(centre[x]) && n >= kMinNeighbours && n - below[size_t(x)] <= n / 12;
+        const int n = ranks.count[size_t(x)];
+        bool candidate =
+            std::isfinite(centre[x]) && n >= kMinNeighbours && n - ranks.below[size_t(x)] <= n / 12;
+        // Q is exact where every neighbour is finite (guardRow's test, in the same precision).
+        if (candidate && n == full && high[x] > 0.0f)
+          candidate = centre[x] > double(o_.highFactor) * double(high[x]);
+        out[size_t(c)][size_t(x)] = candidate;
       }
     }
     return out;

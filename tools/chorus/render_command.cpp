@@ -46,11 +46,26 @@ struct RenderArgs {
   bool quiet = false;
 };
 
+// Below this many samples per pixel `chorus render` without --denoise blends the preview's
+// members (K = 2) instead of the default ones: K = 4 leaves sub-buffers empty there, and every
+// rendered corpus entry (128–160 px, chorus render against its reference) blended 1.8–2.5×
+// better in geometric mean on both halves at 1 and 2 spp, but not at 3 (tuning 0.98, validation
+// 1.31: interior-doorway 8.5× worse); docs/ensemble-quality.md, "Below 4 spp".
+constexpr int kDefaultMembersFromSpp = 3;
+
+bool previewMembersForFewSamples(const RenderArgs& args) {
+  return !args.denoiseGiven && !args.preview &&
+         args.sceneOptions.render.spp < kDefaultMembersFromSpp;
+}
+
 DenoiseStage denoiseStageOf(const RenderArgs& args) {
   CombineOptions options = args.ensemble.options();
   options.combiner = parseCombiner(args.combine);
-  if (args.preview) applyPreviewDefaults(options, args.ensemble);
-  const std::string list = args.denoiseGiven ? args.denoise : args.preview ? "preview" : "default";
+  const bool previewMembers = args.preview || previewMembersForFewSamples(args);
+  if (previewMembers) applyPreviewDefaults(options, args.ensemble);
+  const std::string list = args.denoiseGiven ? args.denoise
+                           : previewMembers  ? "preview"
+                                             : "default";
   DenoiseStage stage = DenoiseStage::parse(list, options, !args.preview);
   stage.keep = args.keep;
   const int needed = stage.splitsNeeded();
@@ -153,6 +168,14 @@ void runRender(RenderArgs args) {
   // Said once nothing can fail any more before the render.
   const std::string fewSamples = fewSamplesWarning(denoise, options);
   if (!fewSamples.empty() && !args.quiet) std::cerr << "chorus: warning: " << fewSamples << "\n";
+  const std::string previewMembers =
+      previewMembersForFewSamples(args)
+          ? "at " + std::to_string(options.spp) + " spp the default members (" + kDefaultDenoise +
+                ") would leave sub-buffers empty: denoising with the preview's (" +
+                kPreviewDenoise + ") instead (--denoise default keeps them)"
+          : "";
+  if (!previewMembers.empty() && !args.quiet)
+    std::cerr << "chorus: note: " << previewMembers << "\n";
 
   const bool showProgress = !args.quiet && TerminalLine::stderrIsTerminal();
   ProgressBar bar(showProgress);
@@ -175,6 +198,7 @@ void runRender(RenderArgs args) {
   out.replacePreviousRun(files);
   nlohmann::ordered_json stats = statsJson(args, options, result.stats, loaded);
   if (!fewSamples.empty()) stats["warnings"].push_back(fewSamples);
+  if (!previewMembers.empty()) stats["notes"].push_back(previewMembers);
   stats["outputs"] = outputsJson(files, leftOutFiles(args, denoise));
   // The denoisers' inputs are copies, so the buffers can move into render.exr's layers (no
   // second copy of a large render in memory), and render.exr is on disk before denoising. A
@@ -245,7 +269,9 @@ const RegisterCommand renderCommand(30, [](CLI::App& app) {
   cmd->add_option("--denoise", args->denoise,
                   std::string("Denoising after the render: none (render.exr keeps the "
                               "sub-buffers and features the default members read), default (") +
-                      kDefaultDenoise + "), preview (" + kPreviewDenoise +
+                      kDefaultDenoise + "; when not given, below " +
+                      std::to_string(kDefaultMembersFromSpp) +
+                      " spp the preview's members), preview (" + kPreviewDenoise +
                       ") or a comma-separated list of base denoisers (name or name:key=value; "
                       "`chorus denoise --help` lists them)")
       ->capture_default_str()

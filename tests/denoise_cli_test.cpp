@@ -308,6 +308,40 @@ TEST(DenoiseCli, MembersAloneOnAOneSubBufferRender) {
   EXPECT_FALSE(fs::exists(bad));
 }
 
+// A render.exr below K spp (rendered with --denoise none, so K = 4): one warning line naming the
+// file and how many sub-buffers are empty (stderr unless --quiet, and stats.json); none at K spp.
+TEST(DenoiseCli, WarnsWhenSubBuffersHoldNoSamples) {
+  TempDir dir("chorus_denoise_empty");
+  const std::string scene = (test::sourceDir() / "scenes" / "cornell-box.gltf").string();
+  for (const char* spp : {"2", "4"}) {
+    const fs::path render = dir / (std::string("r") + spp);
+    auto r = runChorus({"render", scene, "--width", "8", "--spp", spp, "--denoise", "none",
+                        "--quiet", "--out", render.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::string input = (render / "render.exr").string();
+    for (bool quiet : {false, true}) {
+      const fs::path out = dir / (std::string("d") + spp + (quiet ? "q" : ""));
+      std::vector<std::string> args = {"denoise", input,   "--methods",
+                                       "atrous",  "--out", out.string()};
+      if (quiet) args.push_back("--quiet");
+      r = runChorus(args);
+      ASSERT_EQ(r.exitCode, 0) << r.err;
+      const json warnings = readJson(out / "stats.json")["warnings"];
+      if (std::string(spp) == "4") {
+        EXPECT_EQ(r.err, "");
+        EXPECT_EQ(warnings, json::array());
+        continue;
+      }
+      const std::string warning =
+          input +
+          ": 2 of its 4 sub-buffers hold no samples, and the members run on them too: "
+          "render at least 4 spp (or, below 3 spp, denoise in chorus render)";
+      EXPECT_EQ(warnings, json({warning}));
+      EXPECT_EQ(r.err, quiet ? "" : "chorus: warning: " + warning + "\n");
+    }
+  }
+}
+
 // NFOR, RDFC and dual-buffer NL-means alone on a K = 2 render (the full buffer's two halves);
 // the ensemble needs K = 4 for them and says how to run them instead.
 TEST(DenoiseCli, HalvesMembersAloneOnATwoSubBufferRender) {

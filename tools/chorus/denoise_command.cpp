@@ -11,6 +11,7 @@
 // input can feed which member.
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -107,6 +108,26 @@ std::string inputHint(const ReadInput& input, bool alone) {
   if (input.render && input.render->splitCount() < 4)
     return "; render with --splits 4, or run it alone with --combine none";
   return "; run it alone on the full buffer with --combine none";
+}
+
+// A render.exr below K spp has sub-buffers without a sample (sample i goes to sub-buffer
+// i mod K): the members' runs on them, and the ensemble's estimate that compares them, have
+// nothing to work with (docs/ensemble-quality.md, "Below 4 spp"). Empty when every sub-buffer
+// holds samples, or the render recorded no counts.
+std::string emptySubBuffersWarning(const ReadInput& input) {
+  if (!input.render) return {};
+  const int splits = input.render->splitCount();
+  int empty = 0;
+  for (int k = 0; k < splits; ++k) {
+    const Image& count = input.render->sub(k).sampleCount;
+    if (count.empty()) return {};
+    empty += std::all_of(count.values().begin(), count.values().end(),
+                         [](float n) { return n == 0.0f; });
+  }
+  if (empty == 0) return {};
+  return input.path.string() + ": " + std::to_string(empty) + " of its " + std::to_string(splits) +
+         " sub-buffers hold no samples, and the members run on them too: render at least " +
+         std::to_string(splits) + " spp (or, below 3 spp, denoise in chorus render)";
 }
 
 // Throws, naming the input, when a render.exr lacks a feature the members (and, `combined`, the
@@ -242,6 +263,9 @@ void runDenoise(const DenoiseArgs& args) {
     if (needsReference(c) && !reference)
       throw Error("--combine " + std::string(combinerName(c)) + " needs --reference");
   const double readSeconds = total.seconds();
+  const std::string emptySubBuffers = emptySubBuffersWarning(input);
+  if (!emptySubBuffers.empty() && !args.quiet)
+    std::cerr << "chorus: warning: " << emptySubBuffers << "\n";
 
   Json stats;
   stats["input"] = args.input;
@@ -249,6 +273,7 @@ void runDenoise(const DenoiseArgs& args) {
   stats["width"] = input.width();
   stats["height"] = input.height();
   stats["methods"] = specs;
+  stats["warnings"] = emptySubBuffers.empty() ? Json::array() : Json::array({emptySubBuffers});
   Json combinerNames = Json::array();
   for (Combiner c : combiners) combinerNames.push_back(combinerName(c));
   stats["combine"] = combiners.empty() ? Json("none") : combinerNames;

@@ -435,6 +435,37 @@ TEST(MseEstimate, LeaveOneQuarterOutIsUnbiasedForTheThreeQuarterRuns) {
   EXPECT_GT(biasOverSeeds(0, true, MseEstimate::Quarters).worstZ, 10.0);
 }
 
+// A quarter that is 0 everywhere has no samples (a render below 4 spp): its fold would judge
+// every member by its output squared. Left out, the held-out runs compared with it no longer
+// enter the estimate at all; a quarter with samples keeps its fold (the negative control).
+TEST(MseEstimate, AnEmptyQuarterIsNoFold) {
+  for (bool empty : {true, false}) {
+    Fixture f = makeFixture(16, 12, 7, 0.3f, true);
+    if (empty) f.guides.quarters[3].fill(0.0f);
+    MseOptions o;
+    o.estimate = MseEstimate::Quarters;
+    o.windowSigmaColor = 0;  // the colour guide reads the full runs only, but keep it out
+    const MseEstimator before(f.guides, pointers(f), o);
+    const std::vector<PixelMse> was = [&] {
+      std::vector<PixelMse> v;
+      for (int y = 0; y < 12; ++y)
+        for (int x = 0; x < 16; ++x) v.push_back(before.at(x, y));
+      return v;
+    }();
+    for (BaseOutputs& b : f.bases) b.heldOut[3] = scaled(b.heldOut[3], 5.0f);
+    const MseEstimator after(f.guides, pointers(f), o);
+    bool same = true;
+    for (int y = 0; y < 12; ++y)
+      for (int x = 0; x < 16; ++x) {
+        const PixelMse now = after.at(x, y), then = was[size_t(y * 16 + x)];
+        for (int g = 0; g < now.groups; ++g)
+          same = same && now.h[size_t(g)] == then.h[size_t(g)] &&
+                 now.constant[size_t(g)] == then.constant[size_t(g)];
+      }
+    EXPECT_EQ(same, empty) << (empty ? "empty quarter" : "sampled quarter");
+  }
+}
+
 TEST(MseEstimate, RelativeTermsAreUnbiasedUpToTheCommonTerm) {
   // --relative and the image prior divide each fold's terms by its own runs' level (μ_f² + ε):
   // a weight that does not see the fold's comparator keeps the estimate unbiased for what the

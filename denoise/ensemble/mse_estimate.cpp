@@ -4,8 +4,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 
 #include "common/error.h"
 #include "denoise/base/filters/box_filter.h"
@@ -182,8 +184,20 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
     halves[0].out[size_t(i)] = bases[size_t(i)]->a.data();
     halves[1].out[size_t(i)] = bases[size_t(i)]->b.data();
   }
+  // A quarter that is 0 everywhere holds no samples (a render below 4 spp: sample i goes to
+  // sub-buffer i mod 4): compared with it, every member's error term would be its output
+  // squared. Such folds are left out while two or more remain (3 spp: the default job's blend
+  // 0.990 / 0.989 of before, tuning / validation, docs/ensemble-quality.md "Below 4 spp").
+  std::array<bool, 4> sampled{};
+  int sampledCount = 0;
+  for (size_t k = 0; k < 4 && quarters; ++k) {
+    const std::span<const float> q = guides.quarters[k].values();
+    sampled[k] = !std::all_of(q.begin(), q.end(), [](float v) { return v == 0.0f; });
+    sampledCount += sampled[k];
+  }
   if (quarters)
     for (size_t k = 0; k < 4; ++k) {
+      if (sampledCount >= 2 && !sampled[k]) continue;
       Fold fold;
       fold.comparator = guides.quarters[k].data();
       for (int i = 0; i < baseCount_; ++i)

@@ -342,6 +342,37 @@ TEST(DenoiseCli, WarnsWhenSubBuffersHoldNoSamples) {
   }
 }
 
+// --threads T bounds the run's workers (stats.json says how many); the result is the same for
+// any count; out-of-range counts are refused in one line.
+TEST(DenoiseCli, ThreadsChangeNothingButTheWorkers) {
+  TempDir dir("chorus_denoise_threads");
+  const fs::path render = writeRender(dir, 4);
+  const auto run = [&](const std::string& threads, const std::string& name) {
+    std::vector<std::string> args = {
+        "denoise", render.string(), "--methods",          "nfor,atrous",
+        "--quiet", "--out",         (dir / name).string()};
+    if (!threads.empty()) args.insert(args.end(), {"--threads", threads});
+    return runChorus(args);
+  };
+  auto r = run("", "all");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  r = run("1", "one");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(readJson(dir / "one" / "stats.json")["threads"], 1);
+  EXPECT_EQ(readJson(dir / "all" / "stats.json")["threads"], 0);
+  const Image all = readExrLayer(dir / "all" / "ensemble.exr");
+  const Image one = readExrLayer(dir / "one" / "ensemble.exr");
+  ASSERT_TRUE(all.sameShape(one));
+  EXPECT_TRUE(std::equal(all.values().begin(), all.values().end(), one.values().begin()));
+  for (const char* bad : {"-1", "1025", "two"}) {
+    r = run(bad, "bad");
+    EXPECT_EQ(r.exitCode, 2) << bad;
+    EXPECT_EQ(lineCount(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("--threads"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "bad"));
+  }
+}
+
 // NFOR, RDFC and dual-buffer NL-means alone on a K = 2 render (the full buffer's two halves);
 // the ensemble needs K = 4 for them and says how to run them instead.
 TEST(DenoiseCli, HalvesMembersAloneOnATwoSubBufferRender) {

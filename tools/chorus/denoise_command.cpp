@@ -25,6 +25,7 @@
 #include "common/image/png_io.h"
 #include "common/owned_directory.h"
 #include "common/stopwatch.h"
+#include "common/thread_limit.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/buffers_exr.h"
 #include "denoise/buffers/tungsten_dir.h"
@@ -51,6 +52,7 @@ struct DenoiseArgs {
   std::string reference;
   EnsembleFlags ensemble;
   KeptOutputs keep;
+  int threads = 0;  // 0: all cores
   bool quiet = false;
 };
 
@@ -245,6 +247,7 @@ void writeStats(const DenoiseArgs& args, Json& stats, Json& times, const Stopwat
 
 void runDenoise(const DenoiseArgs& args) {
   const Stopwatch total;
+  const ThreadLimit threads(args.threads);
   const std::vector<std::string> specs =
       splitMethodList(args.methods == "default" ? kDefaultDenoise : args.methods);
   const std::vector<Combiner> combiners = combinersOf(args.combine, specs.size());
@@ -273,6 +276,7 @@ void runDenoise(const DenoiseArgs& args) {
   stats["width"] = input.width();
   stats["height"] = input.height();
   stats["methods"] = specs;
+  stats["threads"] = args.threads;
   stats["warnings"] = emptySubBuffers.empty() ? Json::array() : Json::array({emptySubBuffers});
   Json combinerNames = Json::array();
   for (Combiner c : combiners) combinerNames.push_back(combinerName(c));
@@ -391,6 +395,9 @@ const RegisterCommand denoiseCommand(40, [](CLI::App& app) {
   cmd->add_option("--reference", args->reference,
                   "Reference image (.exr): relMSE, DSSIM and PSNR of the noisy input, each member "
                   "and each combination in stats.json, and the oracle combiners");
+  cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")
+      ->capture_default_str()
+      ->transform(integerIn(0, kMaxThreads));
   cmd->add_flag("--quiet", args->quiet, "No progress line and no \"wrote\" lines");
   cmd->callback([args] { runDenoise(*args); });
 });

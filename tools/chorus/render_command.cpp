@@ -16,6 +16,7 @@
 #include "common/image/png_io.h"
 #include "common/owned_directory.h"
 #include "common/stopwatch.h"
+#include "common/thread_limit.h"
 #include "denoise/buffers/buffers_exr.h"
 #include "renderer/render.h"
 #include "tools/chorus/command.h"
@@ -147,6 +148,8 @@ std::vector<LeftOut> leftOutFiles(const RenderArgs& args, const DenoiseStage& de
 
 void runRender(RenderArgs args) {
   const Stopwatch total;
+  // --threads bounds the denoising too, not only the renderer's arena.
+  const ThreadLimit threads(args.sceneOptions.render.threads);
   if (args.preview && !args.sppGiven) args.sceneOptions.render.spp = 4;
   const DenoiseStage denoise = denoiseStageOf(args);
   RenderOptions options = args.sceneOptions.render;

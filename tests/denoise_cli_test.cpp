@@ -339,6 +339,11 @@ TEST(DenoiseCli, WarnsWhenSubBuffersHoldNoSamples) {
       EXPECT_EQ(warnings, json({warning}));
       EXPECT_EQ(r.err, quiet ? "" : "chorus: warning: " + warning + "\n");
     }
+    // A run that fails says its one error line only.
+    r = runChorus(
+        {"denoise", input, "--methods", "atrous,atrous", "--out", (dir / "bad").string()});
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(r.err, "chorus: base denoiser 'atrous' is listed twice\n");
   }
 }
 

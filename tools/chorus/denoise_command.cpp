@@ -237,7 +237,12 @@ void reportWritten(const DenoiseArgs& args, const fs::path& path) {
   if (!args.quiet) std::cout << "wrote " << path.string() << "\n";
 }
 
+// Writes DIR/stats.json, and its warnings on stderr (unless --quiet): at the end, once the run
+// has succeeded, so that a run that fails prints its one error line only.
 void writeStats(const DenoiseArgs& args, Json& stats, Json& times, const Stopwatch& total) {
+  if (!args.quiet)
+    for (const Json& warning : stats["warnings"])
+      std::cerr << "chorus: warning: " << warning.get<std::string>() << "\n";
   times["total"] = total.seconds();
   stats["seconds"] = times;
   const fs::path path = fs::path(args.out) / "stats.json";
@@ -267,8 +272,6 @@ void runDenoise(const DenoiseArgs& args) {
       throw Error("--combine " + std::string(combinerName(c)) + " needs --reference");
   const double readSeconds = total.seconds();
   const std::string emptySubBuffers = emptySubBuffersWarning(input);
-  if (!emptySubBuffers.empty() && !args.quiet)
-    std::cerr << "chorus: warning: " << emptySubBuffers << "\n";
 
   Json stats;
   stats["input"] = args.input;

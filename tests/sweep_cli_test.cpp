@@ -67,6 +67,25 @@ TEST(SweepCli, ProgressLinesWithEta) {
   EXPECT_NE(r.err.find("ETA 0:00:00"), std::string::npos) << r.err;
 }
 
+// Sample counts below K = 4 leave sub-buffers empty: one warning line at the end of the sweep
+// naming them (none unless some spp is below 4, none with --quiet).
+TEST(SweepCli, WarnsAboutSampleCountsBelowFour) {
+  TempDir dir;
+  auto r = runChorus(tinySweep(dir / "low", {"--spp", "1,3,4"}));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const std::string warning =
+      "chorus: warning: at 1, 3 spp some of the 4 sub-buffers get no samples, and the members ran "
+      "on them too (chorus render denoises with the preview's members below 3 spp)\n";
+  EXPECT_NE(r.err.find(warning), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("warning"), r.err.rfind("warning")) << r.err;  // once
+  r = runChorus(tinySweep(dir / "quiet", {"--spp", "2", "--quiet"}));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  r = runChorus(tinySweep(dir / "four", {"--spp", "4"}));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+}
+
 TEST(SweepCli, BadInputIsOneLineNamingIt) {
   TempDir dir;
   const fs::path out = dir / "out";

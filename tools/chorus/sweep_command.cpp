@@ -94,6 +94,19 @@ void runMerge(const SweepArgs& args) {
   printHeadline(args.out, sweep::mergeSweeps(args.out, inputs, info));
 }
 
+// Every case renders K = 4 sub-buffers (sample i to sub-buffer i mod 4): below 4 spp some stay
+// empty and the members run on them too (docs/ensemble-quality.md, "Below 4 spp"). Said at the
+// end of a sweep that succeeded, so that a failing one prints its one error line only.
+std::string lowSppWarning(const std::vector<int>& spps) {
+  std::string few;
+  for (int spp : spps)
+    if (spp < 4) few += (few.empty() ? "" : ", ") + std::to_string(spp);
+  if (few.empty()) return {};
+  return "at " + few +
+         " spp some of the 4 sub-buffers get no samples, and the members ran on them too "
+         "(chorus render denoises with the preview's members below 3 spp)";
+}
+
 void runSweepCommand(const SweepArgs& args) {
   if (!args.merge.empty()) return runMerge(args);
   if (args.scenes.empty()) throw Error("no scenes given (or --merge DIR... to combine sweeps)");
@@ -133,9 +146,12 @@ void runSweepCommand(const SweepArgs& args) {
   const OwnedDirectory out(config.out, {"cases", "references"});  // held for the whole sweep
 
   const sweep::SweepRunStats stats = sweep::runSweep(config);
-  if (!args.quiet)
+  if (!args.quiet) {
     std::cerr << "sweep: ran " << stats.casesRun << " case(s), " << stats.casesSkipped
               << " already done, " << stats.referencesRendered << " reference(s) rendered\n";
+    const std::string few = lowSppWarning(config.spps);
+    if (!few.empty()) std::cerr << "chorus: warning: " << few << "\n";
+  }
   printHeadline(config.out, sweep::readCsv(config.out / "results.csv"));
 }
 

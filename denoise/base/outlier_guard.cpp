@@ -118,38 +118,36 @@ float largest(const float* values, int count, int rank) {
 
 // Per pixel x of a row, over its (2 r + 1)² − 1 neighbours in `rows` (2 r + 1 rows of one
 // channel, `padded` apart, with r NaN columns on the left and NaN up to a whole number of
-// blocks and r more on the right): how many are finite, how many are below the pixel, and the
-// `tops` largest in descending order (largest[k · blocks · kBlock + x]; exact only where every
+// kRankLanes and r more on the right): how many are finite, how many are below the pixel, and
+// the `tops` largest in descending order (largest[k · stride + x]; exact only where every
 // neighbour is finite, which is where it is read).
-constexpr int kBlock = 16;
+constexpr int kRankLanes = 8;
 struct NeighbourRanks {
   NeighbourRanks(int width, int radius, int tops)
-      : blocks((width + kBlock - 1) / kBlock),
-        padded(size_t(blocks * kBlock + 2 * radius)),
+      : stride(size_t((width + kRankLanes - 1) / kRankLanes) * kRankLanes),
+        padded(stride + size_t(2 * radius)),
         tops(tops),
         rows(size_t(2 * radius + 1) * padded, std::numeric_limits<float>::quiet_NaN()),
-        count(size_t(blocks * kBlock)),
-        below(size_t(blocks * kBlock)),
-        largest(size_t(blocks * kBlock) * size_t(tops)) {}
-  int blocks;
-  size_t padded;
+        count(stride),
+        below(stride),
+        largest(stride * size_t(tops)) {}
+  size_t stride, padded;
   int tops;
   std::vector<float> rows;
   std::vector<int> count, below;
   std::vector<float> largest;
 };
 
-// Eight pixels at a time in GCC vector types (each clone picks its instructions), their running
-// counts and lists in registers (written as plain loops, the lists became masked stores).
-using FloatLanes = float __attribute__((vector_size(32)));
-using IntLanes = int __attribute__((vector_size(32)));
-static_assert(kBlock % 8 == 0);
+// kRankLanes pixels at a time in GCC vector types (each clone picks its instructions), their
+// running counts and lists in registers (written as plain loops, the lists became masked stores).
+using FloatLanes = float __attribute__((vector_size(kRankLanes * sizeof(float))));
+using IntLanes = int __attribute__((vector_size(kRankLanes * sizeof(int))));
 
 template <int kTops>
-CHORUS_SIMD_CLONES_EXACT void rankNeighboursOf(const float* rows, size_t padded, int r, int blocks,
-                                               int* count, int* below, float* largest) {
-  const size_t stride = size_t(blocks) * kBlock;
-  for (size_t x0 = 0; x0 < stride; x0 += 8) {
+CHORUS_SIMD_CLONES_EXACT void rankNeighboursOf(const float* rows, size_t padded, int r,
+                                               size_t stride, int* count, int* below,
+                                               float* largest) {
+  for (size_t x0 = 0; x0 < stride; x0 += kRankLanes) {
     FloatLanes centre;
     std::memcpy(&centre, rows + size_t(r) * padded + size_t(r) + x0, sizeof centre);
     IntLanes finite = {}, lower = {};
@@ -183,13 +181,13 @@ void rankNeighbours(int r, NeighbourRanks& ranks) {
   float* largest = ranks.largest.data();
   switch (ranks.tops) {
     case 1:
-      return rankNeighboursOf<1>(rows, ranks.padded, r, ranks.blocks, count, below, largest);
+      return rankNeighboursOf<1>(rows, ranks.padded, r, ranks.stride, count, below, largest);
     case 3:
-      return rankNeighboursOf<3>(rows, ranks.padded, r, ranks.blocks, count, below, largest);
+      return rankNeighboursOf<3>(rows, ranks.padded, r, ranks.stride, count, below, largest);
     case 5:
-      return rankNeighboursOf<5>(rows, ranks.padded, r, ranks.blocks, count, below, largest);
+      return rankNeighboursOf<5>(rows, ranks.padded, r, ranks.stride, count, below, largest);
     case 7:
-      return rankNeighboursOf<7>(rows, ranks.padded, r, ranks.blocks, count, below, largest);
+      return rankNeighboursOf<7>(rows, ranks.padded, r, ranks.stride, count, below, largest);
     default:
       throw std::logic_error("rankNeighbours: unexpected rank");
   }
@@ -325,7 +323,7 @@ class PartGuard {
       }
       rankNeighbours(r, ranks);
       const float* centre = ranks.rows.data() + size_t(r) * ranks.padded + size_t(r);
-      const float* high = ranks.largest.data() + size_t(highRank) * size_t(ranks.blocks * kBlock);
+      const float* high = ranks.largest.data() + size_t(highRank) * ranks.stride;
       out[size_t(c)].resize(size_t(w));
       for (int x = 0; x < w; ++x) {
         const int n = ranks.count[size_t(x)];

@@ -12,6 +12,10 @@
 namespace chorus {
 namespace {
 
+bool oneSample(float n) {
+  return n > 0.0f && n < 2.0f;
+}
+
 // `estimate` where 0 < count < 2, else `variance`.
 Image withFallback(const Image& variance, const Image& count, const Image& estimate) {
   Image out = variance;
@@ -84,14 +88,16 @@ Image halfVarianceOfMean(const DenoiseInput& input, int which, Quantity q) {
                       twoBufferVariance(halves[0], halves[1], q, target));
 }
 
+bool hasOneSamplePixels(const SubBuffer& buffer) {
+  const Image& count = buffer.sampleCount;
+  return count.sameSize(buffer.color.mean) &&
+         std::any_of(count.values().begin(), count.values().end(), oneSample);
+}
+
 Image spatialVarianceWhereOneSample(const SubBuffer& buffer, Quantity q, const Image& variance) {
   const Image& mean = buffer.get(q).mean;
   const Image& count = buffer.sampleCount;
-  // Without one-sample pixels (every run from 4 spp on) this costs one scan of the counts.
-  const auto oneSample = [](float n) { return n > 0.0f && n < 2.0f; };
-  if (!count.sameSize(mean) ||
-      std::none_of(count.values().begin(), count.values().end(), oneSample))
-    return variance;
+  if (!hasOneSamplePixels(buffer)) return variance;
   const int w = mean.width(), h = mean.height(), r = kSpatialVarianceRadius;
   constexpr int kTaps = (2 * kSpatialVarianceRadius + 1) * (2 * kSpatialVarianceRadius + 1);
   constexpr double kMadToSigma = 1.4826;  // σ of a normal distribution per median |deviation|

@@ -49,5 +49,8 @@ Image halfVarianceOfMean(const DenoiseInput& input, int which, Quantity q);
 // overestimate at edges, where a feature-guided filter stops anyway. `variance` itself without
 // sample counts.
 Image spatialVarianceWhereOneSample(const SubBuffer& buffer, Quantity q, const Image& variance);
+// Whether some pixel of `buffer` holds exactly one sample (false without sample counts): where
+// none does (every run from 4 spp on), spatialVarianceWhereOneSample returns `variance` as it is.
+bool hasOneSamplePixels(const SubBuffer& buffer);
 
 }  // namespace chorus

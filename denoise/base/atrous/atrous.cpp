@@ -449,11 +449,12 @@ Image runAtrous(const SubBuffer& buffer, const AtrousParams& given, AtrousKernel
 
 Image Atrous::run(const DenoiseInput& input) const {
   const Image calibrated = calibratedWholeColorVariance(input, params_.calibrationRadius);
+  const Image& recorded = calibrated.empty() ? input.whole.color.varianceOfMean : calibrated;
+  if (!hasOneSamplePixels(input.whole))
+    return runAtrous(input.whole, params_, AtrousKernelPath::Widest, input.sampleShare, &recorded);
   // One-sample pixels (1 spp) record variance 0, which would stop the luminance weight at every
   // difference: there the spread of their neighbourhood instead.
-  const Image variance = spatialVarianceWhereOneSample(
-      input.whole, Quantity::Color,
-      calibrated.empty() ? input.whole.color.varianceOfMean : calibrated);
+  const Image variance = spatialVarianceWhereOneSample(input.whole, Quantity::Color, recorded);
   return runAtrous(input.whole, params_, AtrousKernelPath::Widest, input.sampleShare, &variance);
 }
 

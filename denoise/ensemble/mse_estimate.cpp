@@ -188,22 +188,22 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
   // sub-buffer i mod 4): compared with it, every member's error term would be its output
   // squared. Such folds are left out while two or more remain (3 spp: the default job's blend
   // 0.990 / 0.989 of before, tuning / validation, docs/ensemble-quality.md "Below 4 spp").
-  std::array<bool, 4> sampled{};
-  int sampledCount = 0;
-  for (size_t k = 0; k < 4 && quarters; ++k) {
-    const std::span<const float> q = guides.quarters[k].values();
-    sampled[k] = !std::all_of(q.begin(), q.end(), [](float v) { return v == 0.0f; });
-    sampledCount += sampled[k];
-  }
-  if (quarters)
+  if (quarters) {
+    std::array<bool, 4> sampled{};
     for (size_t k = 0; k < 4; ++k) {
-      if (sampledCount >= 2 && !sampled[k]) continue;
+      const std::span<const float> q = guides.quarters[k].values();
+      sampled[k] = !std::all_of(q.begin(), q.end(), [](float v) { return v == 0.0f; });
+    }
+    const bool dropEmpty = std::count(sampled.begin(), sampled.end(), true) >= 2;
+    for (size_t k = 0; k < 4; ++k) {
+      if (dropEmpty && !sampled[k]) continue;
       Fold fold;
       fold.comparator = guides.quarters[k].data();
       for (int i = 0; i < baseCount_; ++i)
         fold.out[size_t(i)] = bases[size_t(i)]->heldOut[k].data();
       heldOut.push_back(fold);
     }
+  }
   folds_ = quarters ? heldOut : halves;
   if (options.estimate == MseEstimate::Extrapolated && quarters) {
     // e(s) = a + b/s at s = ½, ¾ and 1 of the samples: e(1) = 1.5 e(¾) − 0.5 e(½).

@@ -59,6 +59,14 @@ bool previewMembersForFewSamples(const RenderArgs& args) {
          args.sceneOptions.render.spp < kDefaultMembersFromSpp;
 }
 
+// What previewMembersForFewSamples chose, for stderr and stats.json's notes; empty otherwise.
+std::string previewMembersNote(const RenderArgs& args) {
+  if (!previewMembersForFewSamples(args)) return {};
+  return "at " + std::to_string(args.sceneOptions.render.spp) + " spp the default members (" +
+         kDefaultDenoise + ") would leave sub-buffers empty: denoising with the preview's (" +
+         kPreviewDenoise + ") instead (--denoise default keeps them)";
+}
+
 DenoiseStage denoiseStageOf(const RenderArgs& args) {
   CombineOptions options = args.ensemble.options();
   options.combiner = parseCombiner(args.combine);
@@ -171,12 +179,7 @@ void runRender(RenderArgs args) {
   // Said once nothing can fail any more before the render.
   const std::string fewSamples = fewSamplesWarning(denoise, options);
   if (!fewSamples.empty() && !args.quiet) std::cerr << "chorus: warning: " << fewSamples << "\n";
-  const std::string previewMembers =
-      previewMembersForFewSamples(args)
-          ? "at " + std::to_string(options.spp) + " spp the default members (" + kDefaultDenoise +
-                ") would leave sub-buffers empty: denoising with the preview's (" +
-                kPreviewDenoise + ") instead (--denoise default keeps them)"
-          : "";
+  const std::string previewMembers = previewMembersNote(args);
   if (!previewMembers.empty() && !args.quiet)
     std::cerr << "chorus: note: " << previewMembers << "\n";
 

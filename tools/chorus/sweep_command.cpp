@@ -94,17 +94,18 @@ void runMerge(const SweepArgs& args) {
   printHeadline(args.out, sweep::mergeSweeps(args.out, inputs, info));
 }
 
-// Every case renders K = 4 sub-buffers (sample i to sub-buffer i mod 4): below 4 spp some stay
-// empty and the members run on them too (docs/ensemble-quality.md, "Below 4 spp"). Said at the
-// end of a sweep that succeeded, so that a failing one prints its one error line only.
+// Every case renders K = kCaseSplits sub-buffers (sample i to sub-buffer i mod K): below K spp
+// some stay empty and the members run on them too (docs/ensemble-quality.md, "Below 4 spp").
+// Said at the end of a sweep that succeeded, so that a failing one prints its one error line only.
 std::string lowSppWarning(const std::vector<int>& spps) {
+  constexpr int k = sweep::kCaseSplits;
   std::string few;
   for (int spp : spps)
-    if (spp < 4) few += (few.empty() ? "" : ", ") + std::to_string(spp);
+    if (spp < k) few += (few.empty() ? "" : ", ") + std::to_string(spp);
   if (few.empty()) return {};
-  return "at " + few +
-         " spp some of the 4 sub-buffers get no samples, and the members ran on them too "
-         "(chorus render denoises with the preview's members below 3 spp)";
+  return "at " + few + " spp some of the " + std::to_string(k) +
+         " sub-buffers get no samples, and the members ran on them too (chorus render denoises "
+         "with the preview's members below 3 spp)";
 }
 
 void runSweepCommand(const SweepArgs& args) {
@@ -133,10 +134,10 @@ void runSweepCommand(const SweepArgs& args) {
   // when --width and --height fix the size, else as each scene is loaded (its camera decides).
   const std::vector<EnsembleMember> members = membersFromSpecs(config.methods);
   if (config.render.width > 0 && config.render.height > 0)
-    checkRunMemory({config.render.width, config.render.height}, 4, members);
+    checkRunMemory({config.render.width, config.render.height}, sweep::kCaseSplits, members);
   config.loadScene = [&](const fs::path& path) {
     render::Scene scene = std::move(loadScene(path.string(), args.scene, args.quiet).scene);
-    checkRunMemory(render::renderResolution(scene, config.render), 4, members);
+    checkRunMemory(render::renderResolution(scene, config.render), sweep::kCaseSplits, members);
     return scene;
   };
   config.progress = args.quiet ? nullptr : &std::cerr;

@@ -188,7 +188,7 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
                    const fs::path& referenceFile) {
   render::RenderOptions options = config.render;
   options.spp = c.spp;
-  options.splits = 4;
+  options.splits = kCaseSplits;
   const render::Resolution size = render::renderResolution(scene, options);
   if (reference.width() != size.width || reference.height() != size.height)  // before rendering
     throw fileError(referenceFile, "is " + sizeText(reference.width(), reference.height()) +

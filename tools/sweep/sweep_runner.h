@@ -21,6 +21,8 @@ namespace chorus::sweep {
 
 // Samples per pixel of a rendered reference unless the sweep is given another count or a time.
 inline constexpr int kDefaultReferenceSpp = 16384;
+// Sub-buffers every case renders (the held-out quarters every member can run on).
+inline constexpr int kCaseSplits = 4;
 
 struct SweepConfig {
   std::vector<std::filesystem::path> scenes;

@@ -414,7 +414,7 @@ TEST(RenderCli, PreviewWritesOnlyThePngAndStats) {
   EXPECT_EQ(stats["spp"], 4);
   EXPECT_EQ(stats["denoise"]["methods"],
             json({"atrous:borrow=0.5:spread=12",
-                  "atrous:iterations=4:sigmaL=8:sigmaN=16:borrow=0.5:spread=12"}));
+                  "atrous:iterations=4:sigmaL=8:sigmaN=16:sigmaZ=4:borrow=0.5:spread=12"}));
   EXPECT_EQ(stats["denoise"]["weight_filter"], "none");
   EXPECT_EQ(stats["denoise"]["image_prior"], 0.0);
   EXPECT_EQ(stats["denoise"]["plausibility"], 4.0);

@@ -24,8 +24,12 @@ inline constexpr const char* kDefaultDenoise = "nfor,rdfc,atrous";
 // The previews' members spread an unconfirmed outlier's excess over a radius of 12 instead of 6
 // (the guard's spread=R): at 4 samples per pixel a caustic's one bright sample is a poor guide to
 // where its energy belongs, and a wider spread leaves a fainter blob (docs/ensemble-quality.md).
+// The second member stops at depth edges 4× more loosely (sigmaZ=4): on a sloped surface SVGF's
+// depth weight with sigmaZ=1 is e^-1 at every tap, which keeps that member close to the first;
+// looser, it is the smoother partner the blend needs (docs/ensemble-quality.md).
 inline constexpr const char* kPreviewDenoise =
-    "atrous:borrow=0.5:spread=12,atrous:iterations=4:sigmaL=8:sigmaN=16:borrow=0.5:spread=12";
+    "atrous:borrow=0.5:spread=12,"
+    "atrous:iterations=4:sigmaL=8:sigmaN=16:sigmaZ=4:borrow=0.5:spread=12";
 
 // The ensemble options previews change, each unless its flag was given (EnsembleFlags): no
 // weight filter (it cost more than it gained at 4 spp), no image prior (the two à-trous members

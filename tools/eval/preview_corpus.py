@@ -6,7 +6,9 @@ K = 4 renders, which is not what a preview runs; this is. Extra flags after `--`
 render (e.g. `-- --splits 4`). Prints one line per render and the per-half summary.
 With `--against "FLAGS"` every render also runs without `--preview`, with FLAGS (e.g.
 `--against "--denoise nfor,rdfc,atrous"`, the default job), and the summary gives the preview's
-relMSE over that run's."""
+relMSE over that run's. With `--baseline DIR` (the --out of an earlier run, e.g. with other flags
+or another binary) the summary also gives the preview's relMSE over that run's preview, render by
+render."""
 import argparse
 import json
 import math
@@ -27,6 +29,7 @@ def main():
     parser.add_argument("--seeds", default="1,2,3")
     parser.add_argument("--shared", default=os.environ.get("CHORUS_SHARED_DIR", "../shared"))
     parser.add_argument("--against", help="flags of a run without --preview to compare with")
+    parser.add_argument("--baseline", help="an earlier run's --out to compare the previews with")
     parser.add_argument("flags", nargs="*")
     args = parser.parse_args()
     corpus = json.load(open(args.corpus))
@@ -52,8 +55,12 @@ def main():
             best = min(m["relmse"] for m in members)
             against = render("-against", args.against.split())["denoised"]["relmse"] \
                 if args.against else None
+            baseline = json.load(open(os.path.join(
+                args.baseline, "%s-%s" % (entry["name"], seed), "stats.json"))
+            )["metrics"]["denoised"]["relmse"] if args.baseline else None
             row = (entry["name"], entry["half"], seed, metrics["denoised"]["relmse"], best,
-                   metrics["denoised"]["dssim"] <= min(m["dssim"] for m in members), against)
+                   metrics["denoised"]["dssim"] <= min(m["dssim"] for m in members), against,
+                   baseline)
             rows.append(row)
             print("%-28s %-10s seed %s preview %.4g best member %.4g ratio %.3f" % (
                 row[:5] + (row[3] / best,)) +
@@ -68,12 +75,13 @@ def main():
                   half, len(cases), 100.0 * sum(q < 1 for q in ratios) / len(cases),
                   geometric(ratios), max(ratios),
                   100.0 * sum(r[5] for r in cases) / len(cases)))
-        if args.against:
-            ratios = [r[3] / r[6] for r in cases]
-            worst = max(cases, key=lambda r: r[3] / r[6])
-            print("%s: preview / against: geometric mean %.3f, better in %d of %d, worst %.2f "
-                  "(%s seed %s)" % (half, geometric(ratios), sum(q < 1 for q in ratios),
-                                    len(ratios), max(ratios), worst[0], worst[2]))
+        for column, name in ((6, "against"), (7, "baseline")):
+            if cases and cases[0][column] is not None:
+                ratios = [r[3] / r[column] for r in cases]
+                worst = max(cases, key=lambda r: r[3] / r[column])
+                print("%s: preview / %s: geometric mean %.3f, better in %d of %d, worst %.3f "
+                      "(%s seed %s)" % (half, name, geometric(ratios), sum(q < 1 for q in ratios),
+                                        len(ratios), max(ratios), worst[0], worst[2]))
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@
 
 #include "common/error.h"
 #include "denoise/ensemble/blend.h"
+#include "denoise/ensemble/combiners.h"
 #include "denoise/ensemble/mse_estimate.h"
 #include "denoise/metrics/metrics.h"
 #include "tests/support/test_support.h"
@@ -518,6 +519,56 @@ TEST(MseEstimate, BlendMseEstimatesMatchTheAnalyticError) {
               0.03 * threeQuarterError);
   // The two differ by more than the tolerance, so each test tells them apart.
   EXPECT_GT(halfError - threeQuarterError, 0.1 * threeQuarterError);
+}
+
+// Below 4 spp a quarter holds no samples (all 0). With quarter 3 empty, the runs without
+// quarters 0, 1 or 2 see two quarters (σ²_run = σ_q²/2), and the blend's estimated MSE is the
+// mean of those three folds' errors: (½w2 (c − μ))² + (w1 + ½w2)² σ_q²/2, as above (0.258).
+// Counting the empty fold as a comparator of 0 gave 0.597.
+TEST(MseEstimate, HeldOutBlendMseLeavesAnEmptyQuarterOut) {
+  const int w = 256, h = 256;
+  const double mu = 2.0, c = 3.0, sigmaQ = 0.8, w1 = 0.3, w2 = 0.7;
+  std::mt19937 rng(78);
+  std::normal_distribution<double> noise(0.0, sigmaQ);
+  std::vector<Image> quarters(4, Image(w, h, 3));
+  for (size_t k = 0; k < 3; ++k)
+    for (float& v : quarters[k].values()) v = float(mu + noise(rng));
+  const auto blendOf = [&](double mean) { return w1 * mean + w2 * (0.5 * mean + 0.5 * c); };
+  std::vector<Image> heldOut(4, Image(w, h, 3));
+  for (size_t e = 0; e < heldOut[0].size(); ++e) {
+    double x[3], sum = 0;
+    for (size_t k = 0; k < 3; ++k) sum += x[k] = quarters[k].data()[e];
+    for (size_t k = 0; k < 3; ++k) heldOut[k].data()[e] = float(blendOf((sum - x[k]) / 2.0));
+    heldOut[3].data()[e] = float(blendOf(sum / 3.0));
+  }
+  const double expected =
+      std::pow(0.5 * w2 * (c - mu), 2) + std::pow(w1 + 0.5 * w2, 2) * sigmaQ * sigmaQ / 2;
+  const Image estimate = heldOutBlendMse(heldOut, quarters);
+  double mean = 0;
+  for (float v : estimate.values()) mean += v / double(estimate.size());
+  EXPECT_NEAR(mean, expected, 0.03 * expected);
+}
+
+// Where every member is non-finite in every run, the blends take the noisy counterparts of the
+// runs: for the run without quarter k the mean of the other quarters that hold samples. With
+// quarter 3 empty and the quarters 1, 2, 4 there, the held-out blends are 3, 2.5 and 1.5 (not
+// 2, 5/3 and 1 with the empty quarter's 0 counted), and the blend's estimated MSE there is
+// mean((3 − 1)², (2.5 − 2)², (1.5 − 4)²) − var(1, 2, 4) = 3.5 − 7/3 = 7/6.
+TEST(MseEstimate, WhereNoMemberIsFiniteTheHeldOutBlendsMeanTheSampledQuarters) {
+  Fixture f = makeFixture(16, 12, 9, 0.3f, true);
+  f.guides.quarters[3].fill(0.0f);
+  const float values[3] = {1.0f, 2.0f, 4.0f};
+  for (size_t k = 0; k < 3; ++k)
+    for (int c = 0; c < 3; ++c) f.guides.quarters[k](5, 4, c) = values[k];
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (BaseOutputs& b : f.bases) {
+    b.a = Image();
+    b.b = Image();
+    for (Image& run : b.heldOut)
+      for (int c = 0; c < 3; ++c) run(5, 4, c) = nan;
+  }
+  const CombineResult r = combine(f.guides, pointers(f), {});
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.mseEstimate(5, 4, c), 7.0 / 6.0, 1e-5) << c;
 }
 
 TEST(MseEstimate, OracleIsTheTrueErrorMatrix) {

@@ -2,9 +2,12 @@
 
 #include <tbb/parallel_for.h>
 
+#include <array>
 #include <cmath>
+#include <vector>
 
 #include "common/error.h"
+#include "denoise/ensemble/ensemble_inputs.h"
 
 namespace chorus {
 
@@ -66,15 +69,22 @@ Image heldOutBlendMse(std::span<const Image> heldOutBlends, std::span<const Imag
   for (size_t k = 0; k < 4; ++k)
     if (!heldOutBlends[k].sameShape(like) || !quarters[k].sameShape(like))
       throw Error("heldOutBlendMse: images differ in shape");
+  // The folds of the quarters with samples, as the estimate takes them (an empty quarter says
+  // nothing about the blend's error), while two or more have samples.
+  const std::array<bool, 4> sampled = sampledQuarters(quarters);
+  std::vector<size_t> folds;
+  for (size_t k = 0; k < 4; ++k)
+    if (sampled[k]) folds.push_back(k);
+  if (folds.size() < 2) folds = {0, 1, 2, 3};
+  const double n = double(folds.size());
   Image out(like.width(), like.height(), like.channels());
   for (size_t e = 0; e < out.size(); ++e) {
-    double mean = 0, error = 0;
-    for (size_t k = 0; k < 4; ++k) mean += 0.25 * quarters[k].data()[e];
-    double spread = 0;
-    for (size_t k = 0; k < 4; ++k) {
+    double mean = 0, error = 0, spread = 0;
+    for (size_t k : folds) mean += quarters[k].data()[e] / n;
+    for (size_t k : folds) {
       const double x = quarters[k].data()[e], d = heldOutBlends[k].data()[e] - x;
-      error += 0.25 * d * d;
-      spread += (x - mean) * (x - mean) / 3.0;
+      error += d * d / n;
+      spread += (x - mean) * (x - mean) / (n - 1);
     }
     const double value = error - spread;
     out.data()[e] = std::isfinite(float(value)) ? float(value) : 0.0f;

@@ -30,7 +30,9 @@ Image estimatedBlendMse(const Image& blendA, const Image& blendB, const Image& c
 // without quarter k) and the noisy quarters x_k, k = 0 … 3:
 //   mean_k (z^(−k) − x_k)² − s²,  s² = (1/3) Σ_k (x_k − x̄)²  (the variance of a quarter mean).
 // Unbiased for the mean of the three-quarter blends' squared errors under the same condition;
-// may be negative; non-finite values are written as 0.
+// may be negative; non-finite values are written as 0. Quarters that are 0 everywhere (no
+// samples, below 4 spp) are left out while two or more remain: the means over the F others,
+// s² with F − 1.
 Image heldOutBlendMse(std::span<const Image> heldOutBlends, std::span<const Image> quarters);
 
 }  // namespace chorus

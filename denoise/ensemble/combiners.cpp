@@ -162,7 +162,8 @@ std::vector<const Image*> outputsOf(std::span<const BaseOutputs* const> bases,
 
 // The noisy counterpart of every run the weights are applied to: the value of its blend where
 // no base is finite, and what the noisy fallback puts there. For the runs without quarter k
-// (bases without half runs) the mean of the other three quarters.
+// (bases without half runs) the mean of the other quarters that hold samples (below 4 spp some
+// hold none, and their zeros would darken it).
 struct NoisyRuns {
   const Image& full;
   const Image& a;
@@ -171,13 +172,17 @@ struct NoisyRuns {
 };
 NoisyRuns noisyRunsOf(const EnsembleGuides& guides, bool halfRuns) {
   NoisyRuns noisy{guides.color, guides.colorA, guides.colorB, {}};
+  const std::array<bool, 4> sampled = sampledQuarters(guides.quarters);
   for (size_t k = 0; k < 4 && !halfRuns; ++k) {
     Image& without = noisy.heldOut.emplace_back(guides.width(), guides.height(), 3);
+    std::vector<const float*> others;
+    for (size_t j = 0; j < 4; ++j)
+      if (j != k && sampled[j]) others.push_back(guides.quarters[j].data());
+    if (others.empty()) continue;  // no samples without quarter k: 0, as the image starts
     for (size_t e = 0; e < without.size(); ++e) {
       float sum = 0;
-      for (size_t j = 0; j < 4; ++j)
-        if (j != k) sum += guides.quarters[j].data()[e];
-      without.data()[e] = sum / 3.0f;
+      for (const float* q : others) sum += q[e];
+      without.data()[e] = sum / float(others.size());
     }
   }
   return noisy;

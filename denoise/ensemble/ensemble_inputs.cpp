@@ -1,5 +1,6 @@
 #include "denoise/ensemble/ensemble_inputs.h"
 
+#include <algorithm>
 #include <set>
 
 #include "common/error.h"
@@ -76,6 +77,15 @@ Image meanOfHeldOutRuns(const BaseOutputs& base) {
     mean.data()[e] = float(0.25 * sum);
   }
   return mean;
+}
+
+std::array<bool, 4> sampledQuarters(std::span<const Image> quarters) {
+  std::array<bool, 4> sampled{};
+  for (size_t k = 0; k < quarters.size() && k < 4; ++k) {
+    const std::span<const float> q = quarters[k].values();
+    sampled[k] = !std::all_of(q.begin(), q.end(), [](float v) { return v == 0.0f; });
+  }
+  return sampled;
 }
 
 std::vector<const BaseOutputs*> pointersTo(const std::vector<BaseOutputs>& bases) {

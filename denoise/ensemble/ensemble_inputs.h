@@ -1,9 +1,11 @@
 #pragma once
+
 // The data the ensemble combines: the noisy half-buffer means and features ("guides") and, for
 // every base denoiser, its outputs on half A, half B and the full buffer (what produces them:
 // denoise/pipeline/). Issue 7's sweeps run
 // every base denoiser once and then combine subsets of the same BaseOutputs, so the combination
 // step takes pointers to them (nothing is copied per combination).
+#include <array>
 #include <span>
 #include <string>
 #include <vector>
@@ -49,6 +51,10 @@ void checkEnsembleInputs(const EnsembleGuides& guides, std::span<const BaseOutpu
 // linear filter it equals the full run, and for the nonlinear members it was better on the
 // corpus: docs/ensemble-quality.md). Requires four held-out runs.
 Image meanOfHeldOutRuns(const BaseOutputs& base);
+
+// Which quarters hold samples: one that is 0 everywhere has none (below 4 spp sample i goes to
+// sub-buffer i mod 4). All false without quarters.
+std::array<bool, 4> sampledQuarters(std::span<const Image> quarters);
 
 // Pointers to every element, for combine().
 std::vector<const BaseOutputs*> pointersTo(const std::vector<BaseOutputs>& bases);

@@ -189,11 +189,7 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
   // squared. Such folds are left out while two or more remain (3 spp: the default job's blend
   // 0.990 / 0.989 of before, tuning / validation, docs/ensemble-quality.md "Below 4 spp").
   if (quarters) {
-    std::array<bool, 4> sampled{};
-    for (size_t k = 0; k < 4; ++k) {
-      const std::span<const float> q = guides.quarters[k].values();
-      sampled[k] = !std::all_of(q.begin(), q.end(), [](float v) { return v == 0.0f; });
-    }
+    const std::array<bool, 4> sampled = sampledQuarters(guides.quarters);
     const bool dropEmpty = std::count(sampled.begin(), sampled.end(), true) >= 2;
     for (size_t k = 0; k < 4; ++k) {
       if (dropEmpty && !sampled[k]) continue;

@@ -217,10 +217,12 @@ TEST(EnsembleRunner, LargeImagesAtFewSamplesBlendTheFullRun) {
 }
 
 // Where the blend takes the full runs (large images at few samples) of members that split their
-// own input, the weights come from the wider window (mse.fullRunWindowRadius); members that do
-// not, or blends of the held-out means, keep mse.windowRadius.
+// own input, or the image has 512 x 256 pixels or more, the weights come from the wider window
+// (mse.fullRunWindowRadius); members that do not, or blends of the held-out means of smaller
+// images, keep mse.windowRadius.
 TEST(EnsembleRunner, FullRunsOfMembersThatSplitTheirInputGetTheWiderWindow) {
   const synthetic::Scene scene = synthetic::makeScene(synthetic::SceneKind::Regions, 256, 128);
+  const synthetic::Scene large = synthetic::makeScene(synthetic::SceneKind::Regions, 512, 256);
   std::vector<EnsembleMember> splitting = boxMembers();
   splitting.push_back({"halves", std::make_shared<HalvesDenoiser>()});
   const auto blendWith = [](const EnsembleResult& result, int radius) {
@@ -228,11 +230,14 @@ TEST(EnsembleRunner, FullRunsOfMembersThatSplitTheirInputGetTheWiderWindow) {
     o.mse.windowRadius = radius;
     return combine(result.guides, pointersTo(result.bases), o).image;
   };
-  for (const int perQuarter : {1, 5}) {  // 4 spp: full runs blended; 20 spp: held-out means
-    const SampleBuffers b = synthetic::renderBuffers(scene, {1.0f, perQuarter, 0.0f}, 4, 5);
+  // 4 spp: full runs blended; 20 spp: held-out means (wide only on the large image).
+  for (const int perQuarter : {1, 5, -5}) {
+    const bool isLarge = perQuarter < 0;
+    const SampleBuffers b =
+        synthetic::renderBuffers(isLarge ? large : scene, {1.0f, std::abs(perQuarter), 0.0f}, 4, 5);
     for (const bool split : {true, false}) {
       const EnsembleResult result = Ensemble(split ? splitting : boxMembers(), {}).run(b);
-      const bool wide = split && perQuarter == 1;
+      const bool wide = split && (perQuarter == 1 || isLarge);
       const MseOptions defaults;
       ASSERT_NE(defaults.windowRadius, defaults.fullRunWindowRadius);
       EXPECT_TRUE(

@@ -144,6 +144,7 @@ BaseRuns baseRunsFor(const MseOptions& options, const EnsembleSources& sources) 
   runs.halves = !runs.heldOut || options.estimate == MseEstimate::Extrapolated;
   runs.full = runs.halves || blendsFullRuns(sources.width(), sources.height(),
                                             meanSampleCount(sources.full.whole));
+  runs.large = long(sources.width()) * long(sources.height()) >= kWideWindowPixels;
   return runs;
 }
 
@@ -153,7 +154,7 @@ bool blendsFullRuns(int width, int height, double samplesPerPixel) {
 
 CombineOptions optionsForRuns(CombineOptions options, const BaseRuns& runs,
                               std::span<const EnsembleMember> members) {
-  if (runs.full && runs.heldOut && splitsNeeded(members) == 4)
+  if ((runs.full || runs.large) && runs.heldOut && splitsNeeded(members) == 4)
     options.mse.windowRadius = options.mse.fullRunWindowRadius;
   return options;
 }

@@ -70,6 +70,7 @@ struct BaseRuns {
   bool full = true;      // on the full buffer; else `full` is the mean of the held-out runs
   bool halves = true;    // on half A and half B
   bool heldOut = false;  // on the four inputs without one quarter (held_out_inputs.h)
+  bool large = false;    // the image has at least kWideWindowPixels pixels (optionsForRuns)
 };
 // The runs an estimate needs on these sources: the quarters (and the extrapolated) estimate
 // use the held-out runs when the sources carry four independent quarters (K = 4). The quarters
@@ -90,12 +91,16 @@ inline constexpr double kFullRunSpp = 16;
 bool blendsFullRuns(int width, int height, double samplesPerPixel);
 // `options` for a blend of these runs: the MSE window of radius mse.fullRunWindowRadius (15 by
 // default, a sparse window over box means: mse_estimate.cpp) where the weights, estimated from
-// the held-out runs, blend the full runs (blendsFullRuns) and some member needs two halves of
-// its own input (NFOR, RDFC). Such a member's full run is much better than its held-out runs
-// (three samples of four, split 2 + 1), so the local differences the held-out runs show carry
-// over less than their image-wide ranking; the wider window was 5 % better on both halves of
-// the 256- and 512-px corpora. Members that filter their whole input (the synthetic entries'
-// box, Gaussian and median filters) lost with it: there the radius stays. Else unchanged.
+// the held-out runs, blend the full runs (blendsFullRuns) or the image has at least
+// kWideWindowPixels pixels, and some member needs two halves of its own input (NFOR, RDFC).
+// Such a member's full run is much better than its held-out runs (three samples of four, split
+// 2 + 1), so the local differences the held-out runs show carry over less than their image-wide
+// ranking; the wider window was 5 % better on both halves of the 256- and 512-px corpora. On
+// 512-px images (512 x 341 and up) it also blends the held-out means better (64 spp: 2.8 % on
+// tuning, 0.6 % on validation; at 256 px 1 % worse, so not there). Members that filter their
+// whole input (the synthetic entries' box, Gaussian and median filters) lost with it: there the
+// radius stays. Else unchanged (docs/ensemble-quality.md).
+inline constexpr long kWideWindowPixels = 131072;  // 2^17, e.g. 512 x 256
 CombineOptions optionsForRuns(CombineOptions options, const BaseRuns& runs,
                               std::span<const EnsembleMember> members);
 // Every member on the runs that `runs` asks for, in parallel. Appends "<label>/A",

@@ -75,6 +75,7 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
   blended.heldOut = !outputs.empty() && outputs.begin()->second.heldOut.size() == 4;
   blended.full = !(args.fullFromHeldOut && blended.heldOut &&
                    !blendsFullRuns(guides.width(), guides.height(), spp));
+  blended.large = long(guides.width()) * long(guides.height()) >= kWideWindowPixels;
   if (!blended.full)
     for (auto& [name, o] : outputs) o.full = meanOfHeldOutRuns(o);
   std::vector<sweep::SweepRow> rows = {

@@ -217,9 +217,8 @@ TEST(EnsembleRunner, LargeImagesAtFewSamplesBlendTheFullRun) {
 }
 
 // Where the blend takes the full runs (large images at few samples) of members that split their
-// own input, or the image has 512 x 256 pixels or more, the weights come from the wider window
-// (mse.fullRunWindowRadius); members that do not, or blends of the held-out means of smaller
-// images, keep mse.windowRadius.
+// own input, or the image has 512 x 256 pixels or more (any members), the weights come from the
+// wider window (mse.fullRunWindowRadius); elsewhere mse.windowRadius.
 TEST(EnsembleRunner, FullRunsOfMembersThatSplitTheirInputGetTheWiderWindow) {
   const synthetic::Scene scene = synthetic::makeScene(synthetic::SceneKind::Regions, 256, 128);
   const synthetic::Scene large = synthetic::makeScene(synthetic::SceneKind::Regions, 512, 256);
@@ -237,7 +236,7 @@ TEST(EnsembleRunner, FullRunsOfMembersThatSplitTheirInputGetTheWiderWindow) {
         synthetic::renderBuffers(isLarge ? large : scene, {1.0f, std::abs(perQuarter), 0.0f}, 4, 5);
     for (const bool split : {true, false}) {
       const EnsembleResult result = Ensemble(split ? splitting : boxMembers(), {}).run(b);
-      const bool wide = split && (perQuarter == 1 || isLarge);
+      const bool wide = isLarge || (split && perQuarter == 1);
       const MseOptions defaults;
       ASSERT_NE(defaults.windowRadius, defaults.fullRunWindowRadius);
       EXPECT_TRUE(

@@ -419,6 +419,7 @@ TEST(RenderCli, PreviewWritesOnlyThePngAndStats) {
   EXPECT_EQ(stats["denoise"]["image_prior"], 0.0);
   EXPECT_EQ(stats["denoise"]["plausibility"], 4.0);
   EXPECT_EQ(stats["denoise"]["member_fallback"], 2.0);  // previews' safeguard, unless given
+  EXPECT_EQ(stats["denoise"]["window_used"], 5);  // the wide window only from 2^17 pixels
   const auto off = dir / "preview-off";
   ASSERT_EQ(runChorus({"render", scene.string(), "--width", "24", "--preview", "--member-fallback",
                        "0", "--out", off.string()})

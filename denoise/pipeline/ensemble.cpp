@@ -154,7 +154,7 @@ bool blendsFullRuns(int width, int height, double samplesPerPixel) {
 
 CombineOptions optionsForRuns(CombineOptions options, const BaseRuns& runs,
                               std::span<const EnsembleMember> members) {
-  if ((runs.full || runs.large) && runs.heldOut && splitsNeeded(members) == 4)
+  if (runs.large || (runs.full && runs.heldOut && splitsNeeded(members) == 4))
     options.mse.windowRadius = options.mse.fullRunWindowRadius;
   return options;
 }

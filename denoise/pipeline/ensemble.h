@@ -90,16 +90,18 @@ inline constexpr long kFullRunPixels = 32768;  // 2^15, e.g. 256 x 128
 inline constexpr double kFullRunSpp = 16;
 bool blendsFullRuns(int width, int height, double samplesPerPixel);
 // `options` for a blend of these runs: the MSE window of radius mse.fullRunWindowRadius (15 by
-// default, a sparse window over box means: mse_estimate.cpp) where the weights, estimated from
-// the held-out runs, blend the full runs (blendsFullRuns) or the image has at least
-// kWideWindowPixels pixels, and some member needs two halves of its own input (NFOR, RDFC).
-// Such a member's full run is much better than its held-out runs (three samples of four, split
-// 2 + 1), so the local differences the held-out runs show carry over less than their image-wide
-// ranking; the wider window was 5 % better on both halves of the 256- and 512-px corpora. On
-// 512-px images (512 x 341 and up) it also blends the held-out means better (64 spp: 2.8 % on
-// tuning, 0.6 % on validation; at 256 px 1 % worse, so not there). Members that filter their
-// whole input (the synthetic entries' box, Gaussian and median filters) lost with it: there the
-// radius stays. Else unchanged (docs/ensemble-quality.md).
+// default, a sparse window over box means: mse_estimate.cpp) on images of at least
+// kWideWindowPixels pixels, and on smaller ones where the weights, estimated from the held-out
+// runs, blend the full runs (blendsFullRuns) and some member needs two halves of its own input
+// (NFOR, RDFC). Such a member's full run is much better than its held-out runs (three samples
+// of four, split 2 + 1), so the local differences the held-out runs show carry over less than
+// their image-wide ranking; the wider window was 5 % better on both halves of the 256- and
+// 512-px corpora there. From 512 x 341 pixels on it also blends the held-out means better (64
+// spp: 2.8 % on tuning, 0.6 % on validation; at 256 px 1 % worse, so not there), and the
+// previews' two à-trous members (512 px, 4 spp: 1.8 % / 1.2 %; 256 px: 0.99 / 1.03). Members
+// that filter their whole input (the synthetic entries' box, Gaussian and median filters, at
+// 128–256 px) lost with it at few samples: there the radius stays. Else unchanged
+// (docs/ensemble-quality.md).
 inline constexpr long kWideWindowPixels = 131072;  // 2^17, e.g. 512 x 256
 CombineOptions optionsForRuns(CombineOptions options, const BaseRuns& runs,
                               std::span<const EnsembleMember> members);

@@ -322,6 +322,9 @@ void runDenoise(const DenoiseArgs& args) {
   ensureDirectory(out);
   stats["options"] = combineOptionsJson(options);
   stats["options"].erase("combine");  // one run per --combine value
+  // The radius the weights were estimated with (optionsForRuns widens it on large images).
+  stats["options"]["window_used"] =
+      optionsForRuns(options, runs.used, runs.members).mse.windowRadius;
   std::vector<std::string> written;
   std::vector<LeftOut> leftOut;
   for (size_t k = 0; k < combiners.size(); ++k) {

@@ -486,15 +486,35 @@ TEST(MseEstimate, RelativeTermsAreUnbiasedUpToTheCommonTerm) {
 // (w1 + ½w2)·mean + ½w2·c, whose error is (½w2 (c − μ))² + (w1 + ½w2)² σ²_run, with σ²_run =
 // σ_q²/2 for a half and σ_q²/3 for three quarters. The image mean of each estimate (64k
 // i.i.d. pixels × 3 channels) is within 3 % of that value.
+struct AnalyticBlend {
+  static constexpr int kSide = 256;
+  static constexpr double mu = 2.0, c = 3.0, sigmaQ = 0.8, w1 = 0.3, w2 = 0.7;
+  static double of(double mean) { return w1 * mean + w2 * (0.5 * mean + 0.5 * c); }
+  // The error of a blend of runs on `quarters` quarters.
+  static double error(int quarters) {
+    return std::pow(0.5 * w2 * (c - mu), 2) +
+           std::pow(w1 + 0.5 * w2, 2) * sigmaQ * sigmaQ / double(quarters);
+  }
+  // Four quarters, the first `sampled` of them noisy around μ and the others empty (0).
+  static std::vector<Image> quarters(int sampled, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, sigmaQ);
+    std::vector<Image> out(4, Image(kSide, kSide, 3));
+    for (int k = 0; k < sampled; ++k)
+      for (float& v : out[size_t(k)].values()) v = float(mu + noise(rng));
+    return out;
+  }
+  static double mean(const Image& image) {
+    double sum = 0;
+    for (float v : image.values()) sum += v;
+    return sum / double(image.size());
+  }
+};
+
 TEST(MseEstimate, BlendMseEstimatesMatchTheAnalyticError) {
-  const int w = 256, h = 256;
-  const double mu = 2.0, c = 3.0, sigmaQ = 0.8, w1 = 0.3, w2 = 0.7;
-  std::mt19937 rng(77);
-  std::normal_distribution<double> noise(0.0, sigmaQ);
-  std::vector<Image> quarters(4, Image(w, h, 3));
-  for (Image& q : quarters)
-    for (float& v : q.values()) v = float(mu + noise(rng));
-  const auto blendOf = [&](double mean) { return w1 * mean + w2 * (0.5 * mean + 0.5 * c); };
+  using B = AnalyticBlend;
+  const int w = B::kSide, h = B::kSide;
+  const std::vector<Image> quarters = B::quarters(4, 77);
   Image zA(w, h, 3), zB(w, h, 3), xA(w, h, 3), xB(w, h, 3);
   std::vector<Image> heldOut(4, Image(w, h, 3));
   for (size_t e = 0; e < zA.size(); ++e) {
@@ -502,20 +522,13 @@ TEST(MseEstimate, BlendMseEstimatesMatchTheAnalyticError) {
     for (size_t k = 0; k < 4; ++k) sum += x[k] = quarters[k].data()[e];
     xA.data()[e] = float(0.5 * (x[0] + x[1]));
     xB.data()[e] = float(0.5 * (x[2] + x[3]));
-    zA.data()[e] = float(blendOf(xA.data()[e]));
-    zB.data()[e] = float(blendOf(xB.data()[e]));
-    for (size_t k = 0; k < 4; ++k) heldOut[k].data()[e] = float(blendOf((sum - x[k]) / 3.0));
+    zA.data()[e] = float(B::of(xA.data()[e]));
+    zB.data()[e] = float(B::of(xB.data()[e]));
+    for (size_t k = 0; k < 4; ++k) heldOut[k].data()[e] = float(B::of((sum - x[k]) / 3.0));
   }
-  const double bias2 = std::pow(0.5 * w2 * (c - mu), 2), gain2 = std::pow(w1 + 0.5 * w2, 2);
-  const double halfError = bias2 + gain2 * sigmaQ * sigmaQ / 2;
-  const double threeQuarterError = bias2 + gain2 * sigmaQ * sigmaQ / 3;
-  const auto mean = [](const Image& image) {
-    double sum = 0;
-    for (float v : image.values()) sum += v;
-    return sum / double(image.size());
-  };
-  EXPECT_NEAR(mean(estimatedBlendMse(zA, zB, xA, xB)), halfError, 0.03 * halfError);
-  EXPECT_NEAR(mean(heldOutBlendMse(heldOut, quarters)), threeQuarterError,
+  const double halfError = B::error(2), threeQuarterError = B::error(3);
+  EXPECT_NEAR(B::mean(estimatedBlendMse(zA, zB, xA, xB)), halfError, 0.03 * halfError);
+  EXPECT_NEAR(B::mean(heldOutBlendMse(heldOut, quarters)), threeQuarterError,
               0.03 * threeQuarterError);
   // The two differ by more than the tolerance, so each test tells them apart.
   EXPECT_GT(halfError - threeQuarterError, 0.1 * threeQuarterError);
@@ -523,30 +536,19 @@ TEST(MseEstimate, BlendMseEstimatesMatchTheAnalyticError) {
 
 // Below 4 spp a quarter holds no samples (all 0). With quarter 3 empty, the runs without
 // quarters 0, 1 or 2 see two quarters (σ²_run = σ_q²/2), and the blend's estimated MSE is the
-// mean of those three folds' errors: (½w2 (c − μ))² + (w1 + ½w2)² σ_q²/2, as above (0.258).
-// Counting the empty fold as a comparator of 0 gave 0.597.
+// mean of those three folds' errors, B::error(2) (0.258). Counting the empty fold as a
+// comparator of 0 gave 0.597.
 TEST(MseEstimate, HeldOutBlendMseLeavesAnEmptyQuarterOut) {
-  const int w = 256, h = 256;
-  const double mu = 2.0, c = 3.0, sigmaQ = 0.8, w1 = 0.3, w2 = 0.7;
-  std::mt19937 rng(78);
-  std::normal_distribution<double> noise(0.0, sigmaQ);
-  std::vector<Image> quarters(4, Image(w, h, 3));
-  for (size_t k = 0; k < 3; ++k)
-    for (float& v : quarters[k].values()) v = float(mu + noise(rng));
-  const auto blendOf = [&](double mean) { return w1 * mean + w2 * (0.5 * mean + 0.5 * c); };
-  std::vector<Image> heldOut(4, Image(w, h, 3));
+  using B = AnalyticBlend;
+  const std::vector<Image> quarters = B::quarters(3, 78);
+  std::vector<Image> heldOut(4, Image(B::kSide, B::kSide, 3));
   for (size_t e = 0; e < heldOut[0].size(); ++e) {
     double x[3], sum = 0;
     for (size_t k = 0; k < 3; ++k) sum += x[k] = quarters[k].data()[e];
-    for (size_t k = 0; k < 3; ++k) heldOut[k].data()[e] = float(blendOf((sum - x[k]) / 2.0));
-    heldOut[3].data()[e] = float(blendOf(sum / 3.0));
+    for (size_t k = 0; k < 3; ++k) heldOut[k].data()[e] = float(B::of((sum - x[k]) / 2.0));
+    heldOut[3].data()[e] = float(B::of(sum / 3.0));
   }
-  const double expected =
-      std::pow(0.5 * w2 * (c - mu), 2) + std::pow(w1 + 0.5 * w2, 2) * sigmaQ * sigmaQ / 2;
-  const Image estimate = heldOutBlendMse(heldOut, quarters);
-  double mean = 0;
-  for (float v : estimate.values()) mean += v / double(estimate.size());
-  EXPECT_NEAR(mean, expected, 0.03 * expected);
+  EXPECT_NEAR(B::mean(heldOutBlendMse(heldOut, quarters)), B::error(2), 0.03 * B::error(2));
 }
 
 // Where every member is non-finite in every run, the blends take the noisy counterparts of the

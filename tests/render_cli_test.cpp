@@ -413,13 +413,13 @@ TEST(RenderCli, PreviewWritesOnlyThePngAndStats) {
   const json stats = readJson(out / "stats.json");
   EXPECT_EQ(stats["spp"], 4);
   EXPECT_EQ(stats["denoise"]["methods"],
-            json({"atrous:borrow=0.5:spread=12",
+            json({"atrous:sigmaN=64:borrow=0.5:spread=12",
                   "atrous:iterations=4:sigmaL=8:sigmaN=16:sigmaZ=4:borrow=0.5:spread=12"}));
   EXPECT_EQ(stats["denoise"]["weight_filter"], "none");
   EXPECT_EQ(stats["denoise"]["image_prior"], 0.0);
   EXPECT_EQ(stats["denoise"]["plausibility"], 4.0);
   EXPECT_EQ(stats["denoise"]["member_fallback"], 2.0);  // previews' safeguard, unless given
-  EXPECT_EQ(stats["denoise"]["window_used"], 5);  // the wide window only from 2^17 pixels
+  EXPECT_EQ(stats["denoise"]["window_used"], 5);        // the wide window only from 2^17 pixels
   const auto off = dir / "preview-off";
   ASSERT_EQ(runChorus({"render", scene.string(), "--width", "24", "--preview", "--member-fallback",
                        "0", "--out", off.string()})

@@ -84,6 +84,7 @@ TEST(DenoiseCli, OutputsDirectoryWithReference) {
   const json stats = readJson(out / "stats.json");
   EXPECT_EQ(stats["input_kind"], "outputs directory");
   EXPECT_EQ(stats["width"], 40);
+  EXPECT_EQ(stats["options"]["window_used"], 5);  // the wide window only from 2^17 pixels
   for (const char* stage : {"read", "ensemble/solve", "ensemble/filter", "ensemble/blend",
                             "average/solve", "oracle/solve", "total"})
     EXPECT_TRUE(stats["seconds"].contains(stage)) << stage;
@@ -127,6 +128,7 @@ TEST(DenoiseCli, OptionsReachTheLibrary) {
   // --window sets the one radius used everywhere, full-run blends included.
   EXPECT_EQ(stats["options"]["window"], 0);
   EXPECT_EQ(stats["options"]["full_run_window"], 0);
+  EXPECT_EQ(stats["options"]["window_used"], 0);
 }
 
 TEST(DenoiseCli, CleanFailures) {

@@ -187,6 +187,8 @@ MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& spec
   if (input.outputs) {
     runs.bases = std::move(input.outputs->bases);
     *guides = std::move(input.outputs->guides);
+    // The window's size rule holds for outputs made elsewhere too (optionsForRuns).
+    runs.used.large = long(guides->width()) * long(guides->height()) >= kWideWindowPixels;
     return runs;
   }
   runs.members = fileSafeMembers(specs);

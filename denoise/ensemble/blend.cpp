@@ -2,7 +2,6 @@
 
 #include <tbb/parallel_for.h>
 
-#include <array>
 #include <cmath>
 #include <vector>
 
@@ -69,13 +68,8 @@ Image heldOutBlendMse(std::span<const Image> heldOutBlends, std::span<const Imag
   for (size_t k = 0; k < 4; ++k)
     if (!heldOutBlends[k].sameShape(like) || !quarters[k].sameShape(like))
       throw Error("heldOutBlendMse: images differ in shape");
-  // The folds of the quarters with samples, as the estimate takes them (an empty quarter says
-  // nothing about the blend's error), while two or more have samples.
-  const std::array<bool, 4> sampled = sampledQuarters(quarters);
-  std::vector<size_t> folds;
-  for (size_t k = 0; k < 4; ++k)
-    if (sampled[k]) folds.push_back(k);
-  if (folds.size() < 2) folds = {0, 1, 2, 3};
+  // The folds the weights' estimate compares (an empty quarter says nothing about the error).
+  const std::vector<size_t> folds = comparedFolds(quarters);
   const double n = double(folds.size());
   Image out(like.width(), like.height(), like.channels());
   for (size_t e = 0; e < out.size(); ++e) {

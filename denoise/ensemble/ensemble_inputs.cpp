@@ -88,6 +88,15 @@ std::array<bool, 4> sampledQuarters(std::span<const Image> quarters) {
   return sampled;
 }
 
+std::vector<size_t> comparedFolds(std::span<const Image> quarters) {
+  const std::array<bool, 4> sampled = sampledQuarters(quarters);
+  std::vector<size_t> folds;
+  for (size_t k = 0; k < 4; ++k)
+    if (sampled[k]) folds.push_back(k);
+  if (folds.size() < 2) folds = {0, 1, 2, 3};
+  return folds;
+}
+
 std::vector<const BaseOutputs*> pointersTo(const std::vector<BaseOutputs>& bases) {
   std::vector<const BaseOutputs*> pointers;
   for (const BaseOutputs& base : bases) pointers.push_back(&base);

@@ -55,6 +55,9 @@ Image meanOfHeldOutRuns(const BaseOutputs& base);
 // Which quarters hold samples: one that is 0 everywhere has none (below 4 spp sample i goes to
 // sub-buffer i mod 4). All false without quarters.
 std::array<bool, 4> sampledQuarters(std::span<const Image> quarters);
+// The folds a leave-one-quarter-out estimate compares: the quarters with samples while two or
+// more have them, else all four.
+std::vector<size_t> comparedFolds(std::span<const Image> quarters);
 
 // Pointers to every element, for combine().
 std::vector<const BaseOutputs*> pointersTo(const std::vector<BaseOutputs>& bases);

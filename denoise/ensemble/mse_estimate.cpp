@@ -189,10 +189,7 @@ MseEstimator::MseEstimator(const EnsembleGuides& guides, std::span<const BaseOut
   // squared. Such folds are left out while two or more remain (3 spp: the default job's blend
   // 0.990 / 0.989 of before, tuning / validation, docs/ensemble-quality.md "Below 4 spp").
   if (quarters) {
-    const std::array<bool, 4> sampled = sampledQuarters(guides.quarters);
-    const bool dropEmpty = std::count(sampled.begin(), sampled.end(), true) >= 2;
-    for (size_t k = 0; k < 4; ++k) {
-      if (dropEmpty && !sampled[k]) continue;
+    for (size_t k : comparedFolds(guides.quarters)) {
       Fold fold;
       fold.comparator = guides.quarters[k].data();
       for (int i = 0; i < baseCount_; ++i)

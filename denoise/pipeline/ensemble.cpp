@@ -144,7 +144,6 @@ BaseRuns baseRunsFor(const MseOptions& options, const EnsembleSources& sources) 
   runs.halves = !runs.heldOut || options.estimate == MseEstimate::Extrapolated;
   runs.full = runs.halves || blendsFullRuns(sources.width(), sources.height(),
                                             meanSampleCount(sources.full.whole));
-  runs.large = long(sources.width()) * long(sources.height()) >= kWideWindowPixels;
   return runs;
 }
 
@@ -153,8 +152,9 @@ bool blendsFullRuns(int width, int height, double samplesPerPixel) {
 }
 
 CombineOptions optionsForRuns(CombineOptions options, const BaseRuns& runs,
-                              std::span<const EnsembleMember> members) {
-  if (runs.large || (runs.full && runs.heldOut && splitsNeeded(members) == 4))
+                              std::span<const EnsembleMember> members, int width, int height) {
+  const bool large = long(width) * long(height) >= kWideWindowPixels;
+  if (large || (runs.full && runs.heldOut && splitsNeeded(members) == 4))
     options.mse.windowRadius = options.mse.fullRunWindowRadius;
   return options;
 }
@@ -262,8 +262,8 @@ EnsembleResult Ensemble::run(const EnsembleSources& sources, const Image* refere
   const BaseRuns runs = baseRunsFor(options_.mse, sources);
   result.bases = runBaseDenoisers(sources, members_, &result.times, runs, progress);
   result.guides = guidesFromSources(sources, runs.heldOut);
-  result.combined = combine(result.guides, pointersTo(result.bases),
-                            optionsForRuns(options_, runs, members_), reference);
+  result.options = optionsForRuns(options_, runs, members_, sources.width(), sources.height());
+  result.combined = combine(result.guides, pointersTo(result.bases), result.options, reference);
   result.times.insert(result.times.end(), result.combined.times.begin(),
                       result.combined.times.end());
   return result;

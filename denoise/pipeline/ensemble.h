@@ -70,7 +70,6 @@ struct BaseRuns {
   bool full = true;      // on the full buffer; else `full` is the mean of the held-out runs
   bool halves = true;    // on half A and half B
   bool heldOut = false;  // on the four inputs without one quarter (held_out_inputs.h)
-  bool large = false;    // the image has at least kWideWindowPixels pixels (optionsForRuns)
 };
 // The runs an estimate needs on these sources: the quarters (and the extrapolated) estimate
 // use the held-out runs when the sources carry four independent quarters (K = 4). The quarters
@@ -104,7 +103,7 @@ bool blendsFullRuns(int width, int height, double samplesPerPixel);
 // (docs/ensemble-quality.md).
 inline constexpr long kWideWindowPixels = 131072;  // 2^17, e.g. 512 x 256
 CombineOptions optionsForRuns(CombineOptions options, const BaseRuns& runs,
-                              std::span<const EnsembleMember> members);
+                              std::span<const EnsembleMember> members, int width, int height);
 // Every member on the runs that `runs` asks for, in parallel. Appends "<label>/A",
 // "<label>/B", "<label>/full", "<label>/without-q<k>" (the time of each run) and "bases" (wall
 // time of all of them) to `times`; reports each run's end to `progress`.
@@ -119,6 +118,7 @@ struct EnsembleResult {
   std::vector<BaseOutputs> bases;  // every base output (full, A/B or held out), in member order
   EnsembleGuides guides;           // the noisy inputs the weights were estimated from
   std::vector<StageTime> times;    // every stage: base runs, "bases", "solve", "filter", "blend"
+  CombineOptions options;          // what the blend was combined with (optionsForRuns)
 };
 
 class Ensemble {

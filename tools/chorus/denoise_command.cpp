@@ -187,8 +187,6 @@ MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& spec
   if (input.outputs) {
     runs.bases = std::move(input.outputs->bases);
     *guides = std::move(input.outputs->guides);
-    // The window's size rule holds for outputs made elsewhere too (optionsForRuns).
-    runs.used.large = long(guides->width()) * long(guides->height()) >= kWideWindowPixels;
     return runs;
   }
   runs.members = fileSafeMembers(specs);
@@ -324,13 +322,14 @@ void runDenoise(const DenoiseArgs& args) {
   ensureDirectory(out);
   stats["options"] = combineOptionsJson(options);
   stats["options"].erase("combine");  // one run per --combine value
+  const CombineOptions forRuns =
+      optionsForRuns(options, runs.used, runs.members, guides.width(), guides.height());
   // The radius the weights were estimated with (optionsForRuns widens it on large images).
-  stats["options"]["window_used"] =
-      optionsForRuns(options, runs.used, runs.members).mse.windowRadius;
+  stats["options"]["window_used"] = forRuns.mse.windowRadius;
   std::vector<std::string> written;
   std::vector<LeftOut> leftOut;
   for (size_t k = 0; k < combiners.size(); ++k) {
-    CombineOptions o = optionsForRuns(options, runs.used, runs.members);
+    CombineOptions o = forRuns;
     o.combiner = combiners[k];
     const std::string name(combinerName(o.combiner));
     const CombineResult result =

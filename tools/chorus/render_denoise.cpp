@@ -49,9 +49,7 @@ double DenoiseStage::run(const EnsembleSources& sources, const std::filesystem::
 
   stats["denoise"] = combineOptionsJson(options);
   // The radius the weights were estimated with (optionsForRuns widens it on large images).
-  stats["denoise"]["window_used"] =
-      optionsForRuns(options, baseRunsFor(options.mse, sources), ensemble.members())
-          .mse.windowRadius;
+  stats["denoise"]["window_used"] = result.options.mse.windowRadius;
   stats["denoise"]["methods"] = specs;
   stats["denoise"]["noisy_fallback_pixels"] = result.combined.noisyFallbackPixels;
   if (reference) {

@@ -75,7 +75,6 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
   blended.heldOut = !outputs.empty() && outputs.begin()->second.heldOut.size() == 4;
   blended.full = !(args.fullFromHeldOut && blended.heldOut &&
                    !blendsFullRuns(guides.width(), guides.height(), spp));
-  blended.large = long(guides.width()) * long(guides.height()) >= kWideWindowPixels;
   if (!blended.full)
     for (auto& [name, o] : outputs) o.full = meanOfHeldOutRuns(o);
   std::vector<sweep::SweepRow> rows = {
@@ -86,7 +85,8 @@ std::vector<sweep::SweepRow> evaluate(const Args& args, const fs::path& caseDir,
     std::vector<const BaseOutputs*> chosen;
     const std::vector<std::string> specs = sweep::splitCombination(combo);
     for (const std::string& m : specs) chosen.push_back(&outputs.at(m));
-    const CombineOptions forRuns = optionsForRuns(base, blended, registeredMembers(specs));
+    const CombineOptions forRuns =
+        optionsForRuns(base, blended, registeredMembers(specs), guides.width(), guides.height());
     for (const std::string& name : splitMethodList(args.combiners)) {
       CombineOptions options = forRuns;
       options.combiner = parseCombiner(name);

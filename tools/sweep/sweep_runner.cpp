@@ -253,7 +253,8 @@ CaseResult runCase(const SweepConfig& config, const Plan& plan, const SweepCase&
       membersSeconds += ensembleCost.at(m);
     }
     for (Combiner combiner : plan.combiners) {
-      CombineOptions combineOptions = optionsForRuns(config.combine, blended, memberDenoisers);
+      CombineOptions combineOptions =
+          optionsForRuns(config.combine, blended, memberDenoisers, guides.width(), guides.height());
       combineOptions.combiner = combiner;
       const CombineResult combined =
           combine(guides, members, combineOptions, needsReference(combiner) ? &reference : nullptr);

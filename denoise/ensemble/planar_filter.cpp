@@ -274,9 +274,13 @@ void filterPlaneRows(const PlanarGuides& guides, const BilateralKernel& kernel,
   // not depend on how the image is cut into tiles or rows.
   // Kernel rows are written in whole runs of kLanes (kernelRow): one run of slack.
   const int stride = kBlock + 2 * r + kLanes;
-  std::vector<float> source(size_t(planes) * size_t(rows + 2 * r) * size_t(stride));
-  std::vector<float> k(size_t(2 * r + 1) * size_t(r + 1) * size_t(stride));
-  std::vector<float> acc(size_t(planes + 1) * size_t(rows) * size_t(kBlock));
+  // Per-thread buffers kept between calls (the solve and the weight filter call this once per
+  // band of rows: fresh vectors cost page faults and zero-filling). Every value read below is
+  // written first: the source rows and accumulators per tile, the kernel ring per offset.
+  thread_local std::vector<float> source, k, acc;
+  source.resize(size_t(planes) * size_t(rows + 2 * r) * size_t(stride));
+  k.resize(size_t(2 * r + 1) * size_t(r + 1) * size_t(stride));
+  acc.resize(size_t(planes + 1) * size_t(rows) * size_t(kBlock));
   Tile tile;
   tile.stride = stride;
   tile.r = r;

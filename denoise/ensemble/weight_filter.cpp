@@ -193,7 +193,7 @@ std::vector<Image> crossBilateralFilter(std::span<const Image> maps, const Color
   std::vector<float*> out;
   for (size_t j = 0; j < in.size(); ++j) out.push_back(outPlanes.data() + j * pixels);
   // Tall tasks: the filter evaluates the kernel pairs that straddle a task's top edge twice.
-  constexpr int kRowsPerTask = 32;
+  constexpr int kRowsPerTask = 64;
   tbb::parallel_for(0, (h + kRowsPerTask - 1) / kRowsPerTask, [&](int task) {
     const int y0 = task * kRowsPerTask, y1 = std::min(h, y0 + kRowsPerTask);
     std::vector<float*> rowsOut;

@@ -339,8 +339,14 @@ template <int kD, int kC>
   const int d = kD ? kD : g.d, C = kD ? kC : g.channels;
   Lanes fp[kMaxGramSize];
   centreFeatures(g, d, fp);
-  for (int dy = -g.r; dy <= g.r; ++dy)
-    for (int dx = -g.r; dx <= g.r; ++dx) {
+  // The design row's dx and dy columns counted up from −r (exact small integers, so the same
+  // values as splat(float(dx))): a sixteen-lane splat per offset went through sixteen scalar
+  // stores on AVX2, a third of this function's time.
+  const Lanes one = splat(1.0f), first = splat(float(-g.r));
+  Lanes dyColumn = first;
+  for (int dy = -g.r; dy <= g.r; ++dy, dyColumn += one) {
+    Lanes dxColumn = first;
+    for (int dx = -g.r; dx <= g.r; ++dx, dxColumn += one) {
       const Lanes w = loadVector<Lanes>(groupWeights);
       groupWeights += kLanes;
       if (*skip++) continue;
@@ -353,8 +359,8 @@ template <int kD, int kC>
 #pragma GCC unroll 32
       for (int a = 1; a < d; ++a) {
         const Lanes xa =
-            a == 1   ? splat(float(dx))
-            : a == 2 ? splat(float(dy))
+            a == 1   ? dxColumn
+            : a == 2 ? dyColumn
                      : loadVector<Lanes>(g.fu->row(a - 3, g.y + dy) + g.x0 + dx) - fp[a - 3];
 #pragma GCC unroll 4
         for (int c = 0; c < C; ++c) p[c] += beta[a * C + c] * xa;
@@ -367,6 +373,7 @@ template <int kD, int kC>
       float* wsum = at + size_t(C) * accPlane;
       storeVector(wsum, loadVector<Lanes>(wsum) + w);
     }
+  }
 }
 
 CHORUS_SIMD_CLONES void accumulatePredictions(const Group& g, const float* groupWeights,

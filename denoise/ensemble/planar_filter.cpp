@@ -27,23 +27,21 @@ struct GuideLanes {
   const float* q[12];
 };
 
-// Unaligned loads and stores through references (a vector returned by value would change the
-// ABI of the baseline clone).
-[[gnu::always_inline]] inline void loadLanes(Lanes& v, const float* p) {
-  std::memcpy(&v, p, sizeof v);
-}
-[[gnu::always_inline]] inline void storeLanes(float* p, const Lanes& v) {
-  std::memcpy(p, &v, sizeof v);
-}
-
 // The kernel's arithmetic runs on eight lanes at a time: AVX2's width (with sixteen, GCC split
 // the exponential's selects into SSE pieces and spilled to the stack).
 constexpr int kKernelWidth = 8;
 typedef float KernelLanes __attribute__((vector_size(kKernelWidth * sizeof(float))));
 typedef int32_t KernelInts __attribute__((vector_size(kKernelWidth * sizeof(int32_t))));
 
-[[gnu::always_inline]] inline void loadKernelLanes(KernelLanes& v, const float* p) {
+// Any of these vector types from and to floats at any alignment, through references (a vector
+// returned by value would change the ABI of the baseline clone).
+template <typename V>
+[[gnu::always_inline]] inline void loadVector(V& v, const float* p) {
   std::memcpy(&v, p, sizeof v);
+}
+template <typename V>
+[[gnu::always_inline]] inline void storeVector(float* p, const V& v) {
+  std::memcpy(p, &v, sizeof v);
 }
 
 // fastExpNonPositive(−e) in every lane: the same float operations in the same order, hence the
@@ -70,12 +68,12 @@ typedef int32_t KernelInts __attribute__((vector_size(kKernelWidth * sizeof(int3
 [[gnu::always_inline]] inline void squaredDifferences(const GuideLanes& g, int m0, int at,
                                                       KernelLanes& sum) {
   KernelLanes p, q;
-  loadKernelLanes(p, g.p[m0] + at);
-  loadKernelLanes(q, g.q[m0] + at);
+  loadVector(p, g.p[m0] + at);
+  loadVector(q, g.q[m0] + at);
   sum = (p - q) * (p - q);
   for (int m = m0 + 1; m < m0 + 3; ++m) {
-    loadKernelLanes(p, g.p[m] + at);
-    loadKernelLanes(q, g.q[m] + at);
+    loadVector(p, g.p[m] + at);
+    loadVector(q, g.q[m] + at);
     sum = sum + (p - q) * (p - q);
   }
 }
@@ -98,11 +96,11 @@ template <bool kColor>
       // guide's bounds (|z| ≤ 1e6, V ≤ 1e12) keep every product finite.
       KernelLanes dz[3], sc[3], p, q;
       for (int c = 0; c < 3; ++c) {
-        loadKernelLanes(p, g.p[6 + c] + at);
-        loadKernelLanes(q, g.q[6 + c] + at);
+        loadVector(p, g.p[6 + c] + at);
+        loadVector(q, g.q[6 + c] + at);
         dz[c] = p - q;
-        loadKernelLanes(p, g.p[9 + c] + at);
-        loadKernelLanes(q, g.q[9 + c] + at);
+        loadVector(p, g.p[9 + c] + at);
+        loadVector(q, g.q[9 + c] + at);
         sc[c] = p + q + kVarianceFloor;
       }
       d = d + kc * ((dz[0] * dz[0] * (sc[1] * sc[2]) + dz[1] * dz[1] * (sc[0] * sc[2]) +
@@ -189,14 +187,14 @@ struct RowTerms {
 // (and of the weight sum when kSum) at column col. Per offset the terms are added in the order
 // of the definition — q = p + δ, then q = p − δ — so the accumulators in registers give the
 // same bits as a pass over memory per offset.
-template <int G, bool kSum>
+template <typename V, int G, bool kSum>
 [[gnu::always_inline]] inline void accumulateLanes(const Tile& t, const RowTerms& row, int j0,
                                                    int col) {
   const size_t accAt = size_t(row.y) * size_t(t.width) + size_t(col);
-  Lanes sum{}, acc[G];
-  if (kSum) loadLanes(sum, t.acc + accAt);
+  V sum{}, acc[G];
+  if (kSum) loadVector(sum, t.acc + accAt);
 #pragma GCC unroll 16
-  for (int g = 0; g < G; ++g) loadLanes(acc[g], t.acc + size_t(1 + j0 + g) * t.accPlane + accAt);
+  for (int g = 0; g < G; ++g) loadVector(acc[g], t.acc + size_t(1 + j0 + g) * t.accPlane + accAt);
   const float* source = t.source + size_t(j0) * t.sourcePlane;
   const size_t plusRow = size_t(row.y + row.dy + t.r) * size_t(t.stride);
   const size_t minusRow = size_t(row.y - row.dy + t.r) * size_t(t.stride);
@@ -205,9 +203,9 @@ template <int G, bool kSum>
   for (int dx = row.dxLo; dx <= t.r; dx += t.step) {
     // k(p, p + δ) is stored at s = p, k(p − δ, p) at s = p − δ.
     const size_t plane = size_t(dx + t.r) * t.kernelPlane;
-    Lanes kPlus, kMinus;
-    loadLanes(kPlus, kPlusRow + plane);
-    loadLanes(kMinus, kMinusRow + plane - dx);
+    V kPlus, kMinus;
+    loadVector(kPlus, kPlusRow + plane);
+    loadVector(kMinus, kMinusRow + plane - dx);
     if (kSum) {
       sum += kPlus;
       sum += kMinus;
@@ -216,44 +214,55 @@ template <int G, bool kSum>
 #pragma GCC unroll 16
     for (int g = 0; g < G; ++g) {
       const float* s = source + size_t(g) * t.sourcePlane;
-      Lanes qPlus, qMinus;
-      loadLanes(qPlus, s + plus);
-      loadLanes(qMinus, s + minus);
+      V qPlus, qMinus;
+      loadVector(qPlus, s + plus);
+      loadVector(qMinus, s + minus);
       acc[g] += kPlus * qPlus;
       acc[g] += kMinus * qMinus;
     }
   }
-  if (kSum) storeLanes(t.acc + accAt, sum);
+  if (kSum) storeVector(t.acc + accAt, sum);
 #pragma GCC unroll 16
-  for (int g = 0; g < G; ++g) storeLanes(t.acc + size_t(1 + j0 + g) * t.accPlane + accAt, acc[g]);
+  for (int g = 0; g < G; ++g) storeVector(t.acc + size_t(1 + j0 + g) * t.accPlane + accAt, acc[g]);
 }
 
 // Adds the row of offsets dy to the accumulators of one output row, planes in groups of up to
 // 8 (the weight sum with the first group) so that a group's accumulators stay in registers
 // while the offsets are looped.
-CHORUS_SIMD_CLONES_EXACT void accumulateRow(const Tile& t, int planes, const RowTerms& row) {
-  for (int col = 0; col < t.width; col += kLanes)
+template <typename V>
+[[gnu::always_inline]] inline void accumulateRowOf(const Tile& t, int planes, const RowTerms& row) {
+  for (int col = 0; col < t.width; col += int(sizeof(V) / sizeof(float)))
     for (int j = 0; j < planes;) {
       const int left = planes - j;
       const bool first = j == 0;
       if (left >= 8) {
-        first ? accumulateLanes<8, true>(t, row, j, col)
-              : accumulateLanes<8, false>(t, row, j, col);
+        first ? accumulateLanes<V, 8, true>(t, row, j, col)
+              : accumulateLanes<V, 8, false>(t, row, j, col);
         j += 8;
       } else if (left >= 4) {
-        first ? accumulateLanes<4, true>(t, row, j, col)
-              : accumulateLanes<4, false>(t, row, j, col);
+        first ? accumulateLanes<V, 4, true>(t, row, j, col)
+              : accumulateLanes<V, 4, false>(t, row, j, col);
         j += 4;
       } else if (left >= 2) {
-        first ? accumulateLanes<2, true>(t, row, j, col)
-              : accumulateLanes<2, false>(t, row, j, col);
+        first ? accumulateLanes<V, 2, true>(t, row, j, col)
+              : accumulateLanes<V, 2, false>(t, row, j, col);
         j += 2;
       } else {
-        first ? accumulateLanes<1, true>(t, row, j, col)
-              : accumulateLanes<1, false>(t, row, j, col);
+        first ? accumulateLanes<V, 1, true>(t, row, j, col)
+              : accumulateLanes<V, 1, false>(t, row, j, col);
         j += 1;
       }
     }
+}
+
+// Sixteen lanes per vector where the CPU has AVX-512 (one register each), else eight: sixteen
+// on AVX2 spilled the accumulators (8-15 % slower combination step). The same sums either way.
+CHORUS_SIMD_CLONES_EXACT void accumulateRow(const Tile& t, int planes, const RowTerms& row,
+                                            bool wide) {
+  if (wide)
+    accumulateRowOf<Lanes>(t, planes, row);
+  else
+    accumulateRowOf<KernelLanes>(t, planes, row);
 }
 
 }  // namespace
@@ -266,6 +275,7 @@ void filterPlaneRows(const PlanarGuides& guides, const BilateralKernel& kernel,
   const int reach = r / step * step;  // the furthest offset on the grid of steps
   const int planes = int(in.size());
   const int rows = y1 - y0;
+  const bool wide = cpuHasAvx512f();
   if (planes == 0 || rows <= 0) return;
   // The kernel is symmetric, k(s, s+δ) = k(s+δ, s) bit for bit, so it is evaluated once per
   // pair for the offsets δ of one half-plane and applied in both directions. Every output value
@@ -341,7 +351,7 @@ void filterPlaneRows(const PlanarGuides& guides, const BilateralKernel& kernel,
         }
         if (sy < y0) continue;
         const RowTerms terms{sy - y0, dy, dxLo, slot, (sy - y0) % (dy + 1)};
-        accumulateRow(tile, planes, terms);
+        accumulateRow(tile, planes, terms, wide);
       }
     }
 

@@ -150,6 +150,30 @@ TEST(PlanarFilter, IndependentOfBandsAndInputWindow) {
       ASSERT_EQ(outRows[size_t(j)][e], whole[size_t(j) * pixels + 10 * size_t(w) + e]);
 }
 
+// The accumulation in sixteen-lane vectors (AVX-512 CPUs) and in eight (the others) adds the
+// same terms in the same order: the same bits, whichever this CPU would pick.
+TEST(PlanarFilter, BothAccumulationWidthsGiveTheSameBits) {
+  const int w = 300, h = 23;
+  const PlanarGuides g = randomGuides(w, h, 57, true);
+  BilateralKernel k;
+  k.radius = 5;
+  k.kSpatial = 0.5f / 9.0f;
+  k.kNormal = 5.0f;
+  k.kAlbedo = 8.0f;
+  k.kColor = 0.125f;
+  const int count = 11;  // a group of eight planes, then two and one
+  const std::vector<float> planes = randomPlanes(w, h, count, 43, -1.0f, 3.0f);
+  k.width = BilateralKernel::Width::Sixteen;
+  const std::vector<float> sixteen = filterAll(g, k, planes, count, 7);
+  k.width = BilateralKernel::Width::Eight;
+  const std::vector<float> eight = filterAll(g, k, planes, count, 7);
+  ASSERT_EQ(sixteen.size(), eight.size());
+  for (size_t e = 0; e < sixteen.size(); ++e) ASSERT_EQ(sixteen[e], eight[e]) << e;
+  const std::vector<double> expected = naiveFilter(g, k, planes, count);
+  for (size_t e = 0; e < expected.size(); ++e)
+    ASSERT_NEAR(eight[e], expected[e], 2e-5 * (1 + std::abs(expected[e]))) << e;
+}
+
 TEST(WeightFilter, ConstantMapsStayConstantAndOnTheSimplex) {
   const int w = 40, h = 30;
   const Image normal = test::randomImage(w, h, 3, 61, -1, 1),
@@ -235,6 +259,37 @@ TEST(WeightFilter, ColorGuideIsScaleInvariant) {
       EXPECT_NEAR(scaled.variance.data()[e], reference.variance.data()[e],
                   1e-4 * reference.variance.data()[e] + 1e-12);
     }
+  }
+}
+
+// One pixel of half variance in a constant blend: the guide's variance is that impulse blurred
+// by the 9 × 9 Gaussian (σ 1.7) whose taps are renormalised where they leave the image, written
+// here from the definition, at a corner, an edge and in the interior.
+TEST(WeightFilter, ColorGuideBlursTheHalfVarianceWithRenormalisedBorders) {
+  const int w = 13, h = 11;
+  const WeightFilterOptions options;  // radius 4, σ 1.7, no relative tolerance
+  const double sigma = options.varianceBlurSigma;
+  const int r = options.varianceBlurRadius;
+  const auto tap = [&](int d) { return std::exp(-0.5 * d * d / (sigma * sigma)); };
+  // The weight of position i of n: the taps whose neighbour is inside.
+  const auto norm = [&](int i, int n) {
+    double sum = 0;
+    for (int d = -r; d <= r; ++d)
+      if (i + d >= 0 && i + d < n) sum += tap(d);
+    return sum;
+  };
+  for (const auto& [x0, y0] : {std::pair{0, 0}, std::pair{6, 0}, std::pair{6, 5}}) {
+    Image z(w, h, 3, 1.0f), a(w, h, 3, 1.0f), b(w, h, 3, 1.0f);
+    a(x0, y0, 1) = 3.0f;  // ½(a − b)² = 2 in channel 1 at (x0, y0); the blend's mean |z| is 1
+    const ColorGuide guide = makeColorGuide(z, a, b, options);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const bool near = std::abs(x - x0) <= r && std::abs(y - y0) <= r;
+        const double expected =
+            near ? 2.0 * tap(x - x0) / norm(x, w) * tap(y - y0) / norm(y, h) : 0.0;
+        EXPECT_NEAR(guide.variance(x, y, 1), expected, 1e-6 * (1 + expected)) << x << "," << y;
+        EXPECT_EQ(guide.variance(x, y, 0), 0.0f);
+      }
   }
 }
 

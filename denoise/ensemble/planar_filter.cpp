@@ -275,7 +275,9 @@ void filterPlaneRows(const PlanarGuides& guides, const BilateralKernel& kernel,
   const int reach = r / step * step;  // the furthest offset on the grid of steps
   const int planes = int(in.size());
   const int rows = y1 - y0;
-  const bool wide = cpuHasAvx512f();
+  const bool wide = kernel.width == BilateralKernel::Width::ForThisCpu
+                        ? cpuHasAvx512f()
+                        : kernel.width == BilateralKernel::Width::Sixteen;
   if (planes == 0 || rows <= 0) return;
   // The kernel is symmetric, k(s, s+δ) = k(s+δ, s) bit for bit, so it is evaluated once per
   // pair for the offsets δ of one half-plane and applied in both directions. Every output value

@@ -21,6 +21,9 @@ struct BilateralKernel {
   float kNormal = 0;
   float kAlbedo = 0;
   float kColor = 0;  // needs PlanarGuides::color and ::variance
+  // Vector width of the accumulation: 16 lanes where the CPU has AVX-512, else 8 (the same bits
+  // either way; tests force each).
+  enum class Width { ForThisCpu, Sixteen, Eight } width = Width::ForThisCpu;
 };
 
 // Guides for the whole image, 3 planes each (plane c at data + c·width·height); finite values,

@@ -554,6 +554,7 @@ MseEstimator::FoldTerms MseEstimator::foldTermsAt(size_t pixel, BaseMask mask) c
   const size_t e = pixel * 3;
   FoldTerms t;
   t.folds = int(folds_.size());
+  for (size_t f = 0; f < folds_.size(); ++f) std::fill_n(t.t[f].begin(), baseCount_, 0.0);
   for (int c = 0; c < 3; ++c) {
     const size_t ec = e + size_t(c);
     double mean = 0;

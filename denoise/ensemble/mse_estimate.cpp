@@ -657,8 +657,7 @@ std::vector<BaseMask> MseEstimator::pixelTerms(int y0, int y1, std::vector<float
         const double weight = relative ? 1.0 / (r * r + relativeEpsilon) : absoluteWeight;
         for (int i = 0; i < n; ++i)
           first[size_t(i)] = ((valid >> i) & 1u) ? double(outFull_[size_t(i)][ec]) - r : 0.0;
-        for (int i = 0, k = 0; i < n; ++i)
-          for (int j = i; j < n; ++j, ++k) h[k] += weight * first[size_t(i)] * first[size_t(j)];
+        addOuterProduct(h, weight, first.data(), n);
         continue;
       }
       // Per fold f, e_f = y^f − x_f (halves: e^A = y^A − x^B, e^B = y^B − x^A);

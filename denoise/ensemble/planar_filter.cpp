@@ -1,7 +1,6 @@
 #include "denoise/ensemble/planar_filter.h"
 
 #include <algorithm>
-#include <bit>
 #include <cstdint>
 #include <cstring>
 
@@ -42,26 +41,6 @@ template <typename V>
 template <typename V>
 [[gnu::always_inline]] inline void storeVector(float* p, const V& v) {
   std::memcpy(p, &v, sizeof v);
-}
-
-// fastExpNonPositive(−e) in every lane: the same float operations in the same order, hence the
-// same bits, but as vector code (the scalar form's selects kept GCC from vectorising the loop
-// over lanes, and the exponentials were four fifths of the window's kernel time).
-// (Through references: a vector returned by value would change the ABI of the baseline clone.)
-[[gnu::always_inline]] inline void expNegatedLanes(const KernelLanes& e, KernelLanes& out) {
-  using namespace fast_exp_detail;
-  const KernelLanes zero{};
-  KernelLanes t = -e * kLog2e;
-  t = t > -127.0f ? t : zero - 127.0f;  // NaN compares false: the floor, as in the scalar form
-  t = t < 0.0f ? t : zero;
-  const KernelLanes rounded = t + kRound;
-  const KernelLanes n = rounded - kRound;
-  const KernelInts biased = (KernelInts)rounded - std::bit_cast<int32_t>(kRound) + 127;
-  const KernelLanes y = (t - n) * kLn2;
-  constexpr auto& poly = kExpPolynomial<6>;
-  KernelLanes p = zero + poly[0];
-  for (size_t i = 1; i < poly.size(); ++i) p = p * y + poly[i];
-  out = p * (KernelLanes)(biased << 23);
 }
 
 // sum = Σ_{m = m0 … m0+2} (p_m − q_m)², in that order, for the lanes from `at`.
@@ -108,7 +87,7 @@ template <bool kColor>
                     (sc[0] * sc[1] * sc[2]));
     }
     KernelLanes kv;
-    expNegatedLanes(d, kv);
+    fastExpNegatedVector<KernelLanes, KernelInts>(d, kv);
     std::memcpy(k + at, &kv, sizeof kv);
   }
 }
@@ -275,10 +254,10 @@ void filterPlaneRows(const PlanarGuides& guides, const BilateralKernel& kernel,
   const int reach = r / step * step;  // the furthest offset on the grid of steps
   const int planes = int(in.size());
   const int rows = y1 - y0;
+  if (planes == 0 || rows <= 0) return;
   const bool wide = kernel.width == BilateralKernel::Width::ForThisCpu
                         ? cpuHasAvx512f()
                         : kernel.width == BilateralKernel::Width::Sixteen;
-  if (planes == 0 || rows <= 0) return;
   // The kernel is symmetric, k(s, s+δ) = k(s+δ, s) bit for bit, so it is evaluated once per
   // pair for the offsets δ of one half-plane and applied in both directions. Every output value
   // receives its terms in one fixed order (centre, then per δ: q = p + δ, q = p − δ; a pair

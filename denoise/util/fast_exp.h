@@ -3,9 +3,10 @@
 // pixel pair. Relative error below 1e-6 for x ∈ [−10, 0] and 5e-6 down to −87 (the default
 // degree 6; degree 4 adds 3.5e-6 and saves two multiply-adds); results that
 // would fall below about 2^−126 and NaN inputs give exactly 0; positive inputs are clamped to 0
-// (result 1). The array form uses SSE2 four lanes at a time and the scalar form for the rest;
-// both perform the same float operations in the same order, so every element is bit-identical
-// whichever path computed it (determinism for any tiling).
+// (result 1). The array form uses SSE2 four lanes at a time and the scalar form for the rest,
+// fastExpNegatedVector any GCC vector type; all perform the same float operations in the same
+// order, so every element is bit-identical whichever path computed it (determinism for any
+// tiling).
 #include <array>
 #include <bit>
 #include <cstddef>
@@ -48,6 +49,28 @@ inline float fastExpNonPositive(float x) {
   float p = kExpPolynomial<kDegree>[0];
   for (int i = 1; i <= kDegree; ++i) p = p * y + kExpPolynomial<kDegree>[size_t(i)];
   return p * std::bit_cast<float>(biased << 23);
+}
+
+// fastExpNonPositive<kDegree>(−e) in every lane of a GCC vector of floats V (I: the int32
+// vector of the same lane count): the same float operations in the same order, hence the same
+// bits in each lane, as vector code of any width (a loop over lanes calling the scalar form does
+// not vectorise: its selects need no-trapping-math). Through references: a vector returned by
+// value changes the ABI of the clones built without that width.
+template <typename V, typename I, int kDegree = 6>
+[[gnu::always_inline]] inline void fastExpNegatedVector(const V& e, V& out) {
+  using namespace fast_exp_detail;
+  const V zero{};
+  V t = -e * kLog2e;
+  t = t > -127.0f ? t : zero - 127.0f;  // NaN compares false: the floor, as in the scalar form
+  t = t < 0.0f ? t : zero;
+  const V rounded = t + kRound;
+  const V n = rounded - kRound;
+  const I biased = (I)rounded - std::bit_cast<int32_t>(kRound) + 127;
+  const V y = (t - n) * kLn2;
+  constexpr auto& poly = kExpPolynomial<kDegree>;
+  V p = zero + poly[0];
+  for (size_t i = 1; i < poly.size(); ++i) p = p * y + poly[i];
+  out = p * (V)(biased << 23);
 }
 
 #if defined(__SSE2__)

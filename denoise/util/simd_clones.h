@@ -8,7 +8,13 @@
 // baseline's (and the AVX-512 clone's from the v3 clone's) in the last bit.
 // CHORUS_SIMD_CLONES_EXACT also turns contraction off, so that every clone (and every position in a
 // vectorised loop) gives the same bits.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+// -DCHORUS_NO_AVX512=ON (CMake) leaves the AVX-512 clones out and makes cpuHasAvx512f false: an
+// AVX-512 machine then runs what an AVX2 CPU runs.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(CHORUS_NO_AVX512)
+#define CHORUS_SIMD_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#define CHORUS_SIMD_CLONES_EXACT \
+  __attribute__((target_clones("arch=x86-64-v3", "default"), optimize("fp-contract=off")))
+#elif defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define CHORUS_SIMD_CLONES __attribute__((target_clones("avx512f", "arch=x86-64-v3", "default")))
 #define CHORUS_SIMD_CLONES_EXACT                                        \
   __attribute__((target_clones("avx512f", "arch=x86-64-v3", "default"), \
@@ -21,7 +27,7 @@
 // What the CPU running this supports, for code that picks its own path (explicit kernels, or a
 // blocking that has to match the clone the ifunc resolver picked). Asked once.
 inline bool cpuHasAvx512f() {
-#if defined(__x86_64__) && defined(__GNUC__)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(CHORUS_NO_AVX512)
   static const bool has = __builtin_cpu_supports("avx512f");
   return has;
 #else

@@ -265,9 +265,10 @@ TEST(CollaborativeRegression, MatchesPerWindowPivotedQrInNforsShape) {
 }
 
 // The Gram sums are blocked for the CPU's vector registers (AVX-512: two design rows over half a
-// group's lanes; otherwise one row over a quarter); every sum adds the same terms in the same
-// order, so both blockings give the same bits, in NFOR's shape and the generic one, for powered
-// weights too. (Whichever blocking this CPU prefers, both run here.)
+// group's lanes; otherwise one row over a quarter, with the weights, columns and predictions
+// eight lanes at a time); every sum adds the same terms in the same order, so both blockings give
+// the same bits, in NFOR's shape and the generic one, for powered weights too. (Whichever
+// blocking this CPU prefers, both run here.)
 TEST(CollaborativeRegression, BothSumBlockingsGiveTheSameBits) {
   for (int features : {3, 8}) {
     Scene s = affineScene(37, 23, features, 50);

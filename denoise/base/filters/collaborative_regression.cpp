@@ -69,6 +69,11 @@ using SumLanes = double __attribute__((vector_size(kLanes * sizeof(double))));
 [[gnu::always_inline]] inline SumLanes wide(Lanes v) {
   return __builtin_convertvector(v, SumLanes);
 }
+// Eight lanes (the AVX2 path's part of a group) and their values in double.
+using EightLanes = float __attribute__((vector_size(8 * sizeof(float))));
+[[gnu::always_inline]] inline HalfSums eightWide(EightLanes v) {
+  return __builtin_convertvector(v, HalfSums);
+}
 
 // Columns of the design matrix and of the data: d ≤ kMaxGramSize, C ≤ kMaxGramRhs.
 constexpr int kMaxColumns = kMaxGramSize + kMaxGramRhs;
@@ -100,12 +105,15 @@ constexpr float kSmallestWeight = 1.6e-18f;
 // bandwidth k / √p, whose distances are p times larger (up to ε and the distance clamp, which
 // only decide where weights are 0 anyway). Like computed weights, they are 0 where exp would
 // underflow, and the centre weight keeps the floor of CenterWeight::Computed.
-[[gnu::always_inline]] inline Lanes toPower(const Group& g, Lanes w, int dx, int dy) {
-  Lanes p = w;
+// V: the group's lanes [lane0, lane0 + width of V).
+template <typename V>
+[[gnu::always_inline]] inline V toPower(const Group& g, V w, int dx, int dy, int lane0) {
+  constexpr int width = int(sizeof(V) / sizeof(float));
+  V p = w;
   for (int e = 1; e < g.power; ++e) p *= w;
-  p = p < splat(kSmallestWeight) ? Lanes{} : p;
+  p = p < (V{} + kSmallestWeight) ? V{} : p;
   if (dx == 0 && dy == 0 && g.floorCentre)
-    for (int lane = 0; lane < g.insideLanes; ++lane)
+    for (int lane = 0; lane < width && lane < g.insideLanes - lane0; ++lane)
       p[lane] = p[lane] < g.centreFloor ? g.centreFloor : p[lane];
   return p;
 }
@@ -260,6 +268,8 @@ template <typename Blocks, int kD, int kC>
   const int count = d * (d + 1) / 2 + d * C, side = 2 * g.r + 1;
   Lanes fp[kMaxGramSize];
   centreFeatures(g, d, fp);
+  float fpMemory[kMaxGramSize][kLanes];  // the same, read in parts by the AVX2 path
+  for (int j = 0; j < d - 3; ++j) storeVector(fpMemory[j], fp[j]);
   for (int h = 0; h < 2; ++h)
     for (int e = 0; e < count; ++e) storeVector(sums.half[h][e], HalfSums{});
   OffsetColumns* cols[2] = {scratch.columns.data(), scratch.columns.data() + side};
@@ -272,29 +282,58 @@ template <typename Blocks, int kD, int kC>
       // Each offset's weights are in another plane of the table, a cache line no hardware
       // prefetcher predicts: ask for the next window row's while this one is summed.
       if (dy < g.r) __builtin_prefetch(offsetWeights(g, dx, dy + 1));
-      Lanes w = loadVector<Lanes>(offsetWeights(g, dx, dy));
-      if (g.power > 1) w = toPower(g, w, dx, dy);
-      storeVector(groupWeights, w);
+      const float* table = offsetWeights(g, dx, dy);
+      if constexpr (Blocks::rowsPerBlock == 2) {
+        Lanes w = loadVector<Lanes>(table);
+        if (g.power > 1) w = toPower(g, w, dx, dy, 0);
+        storeVector(groupWeights, w);
+      } else {
+        // Eight lanes at a time (AVX2): sixteen-lane weights were assembled from four SSE
+        // pieces through the stack and reloaded whole, a store-forwarding stall per offset.
+        for (int lane0 = 0; lane0 < kLanes; lane0 += 8) {
+          EightLanes w = loadVector<EightLanes>(table + lane0);
+          if (g.power > 1) w = toPower(g, w, dx, dy, lane0);
+          storeVector(groupWeights + lane0, w);
+        }
+      }
       // Every lane +0 (weights are never negative): the bits OR-ed.
       uint64_t bits[kLanes / 2];
       std::memcpy(bits, groupWeights, sizeof bits);
+      const float* w = groupWeights;
       groupWeights += kLanes;
       *skip = ((bits[0] | bits[1]) | (bits[2] | bits[3]) | (bits[4] | bits[5]) |
                (bits[6] | bits[7])) == 0;
       if (*skip++) continue;
-      OffsetColumns &lo = cols[0][live], &hi = cols[1][live];
+      OffsetColumns* part[2] = {&cols[0][live], &cols[1][live]};
       ++live;
-      storeHalves(lo.w, hi.w, wide(w));
-      fillColumn(lo.x[0], 1.0);
-      fillColumn(hi.x[0], 1.0);
-      fillColumn(lo.x[1], double(float(dx)));
-      fillColumn(hi.x[1], double(float(dx)));
+      if constexpr (Blocks::rowsPerBlock == 2) {
+        storeHalves(part[0]->w, part[1]->w, wide(loadVector<Lanes>(w)));
 #pragma GCC unroll 32
-      for (int j = 0; j < d - 3; ++j)
-        storeHalves(lo.x[3 + j], hi.x[3 + j], wide(loadVector<Lanes>(planes[3 + j] + dx) - fp[j]));
+        for (int j = 0; j < d - 3; ++j)
+          storeHalves(part[0]->x[3 + j], part[1]->x[3 + j],
+                      wide(loadVector<Lanes>(planes[3 + j] + dx) - fp[j]));
 #pragma GCC unroll 8
-      for (int c = 0; c < C; ++c)
-        storeHalves(lo.x[d + c], hi.x[d + c], wide(loadVector<Lanes>(planes[d + c] + dx)));
+        for (int c = 0; c < C; ++c)
+          storeHalves(part[0]->x[d + c], part[1]->x[d + c],
+                      wide(loadVector<Lanes>(planes[d + c] + dx)));
+      } else {
+        for (int h = 0; h < 2; ++h) {
+          const int lane0 = h * kHalf;
+          OffsetColumns& to = *part[h];
+          storeVector(to.w, eightWide(loadVector<EightLanes>(w + lane0)));
+#pragma GCC unroll 32
+          for (int j = 0; j < d - 3; ++j)
+            storeVector(to.x[3 + j], eightWide(loadVector<EightLanes>(planes[3 + j] + dx + lane0) -
+                                               loadVector<EightLanes>(fpMemory[j] + lane0)));
+#pragma GCC unroll 8
+          for (int c = 0; c < C; ++c)
+            storeVector(to.x[d + c], eightWide(loadVector<EightLanes>(planes[d + c] + dx + lane0)));
+        }
+      }
+      for (OffsetColumns* to : part) {
+        fillColumn(to->x[0], 1.0);
+        fillColumn(to->x[1], double(float(dx)));
+      }
     }
     if (live == 0) continue;  // the row would add 0 to every sum
     for (int h = 0; h < 2; ++h)
@@ -330,60 +369,79 @@ CHORUS_SIMD_CLONES void accumulateSums(const Group& g, GroupSums& sums, float* g
 // acc_c(q) += w_δ(p) · x_qᵀ β_c(p) and wsum(q) += w_δ(p) for every q = p + δ of the group's
 // windows. beta[a · C + c] holds β_a,c of every lane; acc has C planes then wsum, each
 // `accWidth` wide, positioned so that the group's first centre is at accAt.
-template <int kD, int kC>
+// V holds sixteen lanes (AVX-512) or eight (AVX2: with sixteen-lane vectors the centre
+// features and the predictions took two registers each and spilled on every offset); the parts
+// of a group take turns within each offset, so every accumulator (a pixel in the windows of
+// several lanes) adds the same terms in the same order either way: both give the same bits.
+template <int kD, int kC, typename V>
 [[gnu::always_inline]] inline void accumulatePredictionsOf(const Group& g,
                                                            const float* groupWeights,
                                                            const uint8_t* skip, const Lanes* beta,
                                                            float* acc, size_t accWidth,
                                                            size_t accPlane, size_t accAt) {
+  constexpr int width = int(sizeof(V) / sizeof(float));
   const int d = kD ? kD : g.d, C = kD ? kC : g.channels;
-  Lanes fp[kMaxGramSize];
-  centreFeatures(g, d, fp);
+  const float* betas = reinterpret_cast<const float*>(beta);
+  // The centre features, read back from memory per part rather than held in registers.
+  float fp[kMaxGramSize][kLanes];
+  for (int j = 0; j < d - 3; ++j) std::memcpy(fp[j], g.fu->row(j, g.y) + g.x0, sizeof fp[j]);
   // The design row's dx and dy columns counted up from −r (exact small integers, so the same
-  // values as splat(float(dx))): a sixteen-lane splat per offset went through sixteen scalar
-  // stores on AVX2, a third of this function's time.
-  const Lanes one = splat(1.0f), first = splat(float(-g.r));
-  Lanes dyColumn = first;
+  // values as a splat of float(dx)): a sixteen-lane splat per offset went through sixteen
+  // scalar stores on AVX2, a third of this function's time.
+  const V one = V{} + 1.0f, first = V{} + float(-g.r);
+  V dyColumn = first;
   for (int dy = -g.r; dy <= g.r; ++dy, dyColumn += one) {
-    Lanes dxColumn = first;
-    for (int dx = -g.r; dx <= g.r; ++dx, dxColumn += one) {
-      const Lanes w = loadVector<Lanes>(groupWeights);
-      groupWeights += kLanes;
+    V dxColumn = first;
+    for (int dx = -g.r; dx <= g.r; ++dx, dxColumn += one, groupWeights += kLanes) {
       if (*skip++) continue;
-      // p_c = x_qᵀ β_c with the design row x_q = [1, dx, dy, f_j(q) − f_j(p) …], column by
-      // column (x_0 = 1) for every channel at once, so that only the C predictions are live
-      // across the row; each p_c adds its terms in order of a, as the Gram sums did.
-      Lanes p[kMaxGramRhs];
-#pragma GCC unroll 4
-      for (int c = 0; c < C; ++c) p[c] = beta[c];
-#pragma GCC unroll 32
-      for (int a = 1; a < d; ++a) {
-        const Lanes xa =
-            a == 1   ? dxColumn
-            : a == 2 ? dyColumn
-                     : loadVector<Lanes>(g.fu->row(a - 3, g.y + dy) + g.x0 + dx) - fp[a - 3];
-#pragma GCC unroll 4
-        for (int c = 0; c < C; ++c) p[c] += beta[a * C + c] * xa;
-      }
       float* at = acc + accAt + ptrdiff_t(dy) * ptrdiff_t(accWidth) + dx;
-      for (int c = 0; c < C; ++c) {
-        float* plane = at + size_t(c) * accPlane;
-        storeVector(plane, loadVector<Lanes>(plane) + w * p[c]);
+      for (int lane0 = 0; lane0 < kLanes; lane0 += width) {
+        // p_c = x_qᵀ β_c with the design row x_q = [1, dx, dy, f_j(q) − f_j(p) …], column by
+        // column (x_0 = 1) for every channel at once, so that only the C predictions are live
+        // across the row; each p_c adds its terms in order of a, as the Gram sums did.
+        V p[kMaxGramRhs];
+#pragma GCC unroll 4
+        for (int c = 0; c < C; ++c) p[c] = loadVector<V>(betas + c * kLanes + lane0);
+#pragma GCC unroll 32
+        for (int a = 1; a < d; ++a) {
+          const V xa = a == 1   ? dxColumn
+                       : a == 2 ? dyColumn
+                                : loadVector<V>(g.fu->row(a - 3, g.y + dy) + g.x0 + dx + lane0) -
+                                      loadVector<V>(fp[a - 3] + lane0);
+#pragma GCC unroll 4
+          for (int c = 0; c < C; ++c)
+            p[c] += loadVector<V>(betas + (a * C + c) * kLanes + lane0) * xa;
+        }
+        const V w = loadVector<V>(groupWeights + lane0);
+        for (int c = 0; c < C; ++c) {
+          float* plane = at + size_t(c) * accPlane + lane0;
+          storeVector(plane, loadVector<V>(plane) + w * p[c]);
+        }
+        float* wsum = at + size_t(C) * accPlane + lane0;
+        storeVector(wsum, loadVector<V>(wsum) + w);
       }
-      float* wsum = at + size_t(C) * accPlane;
-      storeVector(wsum, loadVector<Lanes>(wsum) + w);
     }
   }
 }
 
+// wide: all sixteen lanes at once (AVX-512), else eight at a time (as accumulateSums's blocks).
 CHORUS_SIMD_CLONES void accumulatePredictions(const Group& g, const float* groupWeights,
                                               const uint8_t* skip, const Lanes* beta, float* acc,
-                                              size_t accWidth, size_t accPlane, size_t accAt) {
-  if (g.d == kNforColumns && g.channels == kNforChannels)
-    accumulatePredictionsOf<kNforColumns, kNforChannels>(g, groupWeights, skip, beta, acc, accWidth,
-                                                         accPlane, accAt);
+                                              size_t accWidth, size_t accPlane, size_t accAt,
+                                              bool wide) {
+  const bool nfor = g.d == kNforColumns && g.channels == kNforChannels;
+  if (nfor && wide)
+    accumulatePredictionsOf<kNforColumns, kNforChannels, Lanes>(g, groupWeights, skip, beta, acc,
+                                                                accWidth, accPlane, accAt);
+  else if (nfor)
+    accumulatePredictionsOf<kNforColumns, kNforChannels, EightLanes>(
+        g, groupWeights, skip, beta, acc, accWidth, accPlane, accAt);
+  else if (wide)
+    accumulatePredictionsOf<0, 0, Lanes>(g, groupWeights, skip, beta, acc, accWidth, accPlane,
+                                         accAt);
   else
-    accumulatePredictionsOf<0, 0>(g, groupWeights, skip, beta, acc, accWidth, accPlane, accAt);
+    accumulatePredictionsOf<0, 0, EightLanes>(g, groupWeights, skip, beta, acc, accWidth, accPlane,
+                                              accAt);
 }
 
 // A tile: kTileSize columns starting at x0 (the last tile of a row may extend past the image:
@@ -503,7 +561,7 @@ class Regression {
         solveLanes(st.sums, std::min(kLanes, width_ - x0), beta);
         const size_t at = size_t(y - out.extent.y0) * accWidth + size_t(x0 - out.extent.x0);
         accumulatePredictions(g, st.groupWeights.data(), st.skip.data(), beta, out.acc.data(),
-                              accWidth, accPlane, at);
+                              accWidth, accPlane, at, wide_);
       }
   }
 

@@ -424,24 +424,29 @@ template <int kD, int kC, typename V>
   }
 }
 
+template <typename V>
+[[gnu::always_inline]] inline void accumulatePredictionsIn(const Group& g,
+                                                           const float* groupWeights,
+                                                           const uint8_t* skip, const Lanes* beta,
+                                                           float* acc, size_t accWidth,
+                                                           size_t accPlane, size_t accAt) {
+  if (g.d == kNforColumns && g.channels == kNforChannels)
+    accumulatePredictionsOf<kNforColumns, kNforChannels, V>(g, groupWeights, skip, beta, acc,
+                                                            accWidth, accPlane, accAt);
+  else
+    accumulatePredictionsOf<0, 0, V>(g, groupWeights, skip, beta, acc, accWidth, accPlane, accAt);
+}
+
 // wide: all sixteen lanes at once (AVX-512), else eight at a time (as accumulateSums's blocks).
 CHORUS_SIMD_CLONES void accumulatePredictions(const Group& g, const float* groupWeights,
                                               const uint8_t* skip, const Lanes* beta, float* acc,
                                               size_t accWidth, size_t accPlane, size_t accAt,
                                               bool wide) {
-  const bool nfor = g.d == kNforColumns && g.channels == kNforChannels;
-  if (nfor && wide)
-    accumulatePredictionsOf<kNforColumns, kNforChannels, Lanes>(g, groupWeights, skip, beta, acc,
-                                                                accWidth, accPlane, accAt);
-  else if (nfor)
-    accumulatePredictionsOf<kNforColumns, kNforChannels, EightLanes>(
-        g, groupWeights, skip, beta, acc, accWidth, accPlane, accAt);
-  else if (wide)
-    accumulatePredictionsOf<0, 0, Lanes>(g, groupWeights, skip, beta, acc, accWidth, accPlane,
-                                         accAt);
+  if (wide)
+    accumulatePredictionsIn<Lanes>(g, groupWeights, skip, beta, acc, accWidth, accPlane, accAt);
   else
-    accumulatePredictionsOf<0, 0, EightLanes>(g, groupWeights, skip, beta, acc, accWidth, accPlane,
-                                              accAt);
+    accumulatePredictionsIn<EightLanes>(g, groupWeights, skip, beta, acc, accWidth, accPlane,
+                                        accAt);
 }
 
 // A tile: kTileSize columns starting at x0 (the last tile of a row may extend past the image:

@@ -314,6 +314,133 @@ def env_objects(directory):
     gltf.write(directory, embed_buffer=True)
 
 
+# ---------------------------------------------------------------------------------------------
+# Small and thin lights seen directly or in mirrors (added 2026-12-07, thirteenth session: the
+# first four, never tuned on, broke the guard's spread, NFOR and SBF; docs/outliers.md)
+
+
+@scene
+def plastic_two_lights(directory):
+    """Issue 28's Tungsten case rebuilt: a smooth and a rough plastic sphere on a checker floor
+    under two coloured quad lights: large specular highlights on the smooth sphere."""
+    gltf = gs.Gltf("plastic-two-lights")
+    floor = textured(gltf, "checker", fine_checker_png(128, 8), roughness=0.7)
+    add_quad(gltf, "floor", [(-4, 0, 4), (4, 0, 4), (4, 0, -4), (-4, 0, -4)], (0, 1, 0), floor,
+             uv_scale=(4, 4))
+    add_sphere(gltf, "smooth", gltf.material("smooth plastic", (0.7, 0.1, 0.1), 0.0, 0.05),
+               (-0.6, 0.5, 0.0), 0.5)
+    add_sphere(gltf, "rough", gltf.material("rough plastic", (0.1, 0.3, 0.7), 0.0, 0.45),
+               (0.6, 0.5, -0.2), 0.5)
+    for name, colour, x in (("warm", (1.0, 0.6, 0.3), -1.8), ("cool", (0.3, 0.6, 1.0), 1.8)):
+        add_quad(gltf, name, [(x - 0.3, 2.0, -0.3), (x + 0.3, 2.0, -0.3), (x + 0.3, 2.0, 0.3),
+                              (x - 0.3, 2.0, 0.3)], (0, -1, 0), emissive(gltf, name, colour, 25.0))
+    add_camera(gltf, (0.0, 1.4, 3.2), (0.0, 0.4, 0.0), 40.0, 1.5)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+@scene
+def slit_glossy_floor(directory):
+    """The Cornell room lit by a slit light two pixels high on the back wall, seen directly, over
+    a dark glossy floor: at 4 spp most of the slit's pixels are partly covered."""
+    gltf = gs.Gltf("slit-glossy-floor")
+    white = cornell_room(gltf, gltf.material("dark gloss", (0.08, 0.08, 0.09), 0.0, 0.12))
+    add_quad(gltf, "slit", [(-0.7, 1.6, -0.995), (0.7, 1.6, -0.995), (0.7, 1.62, -0.995),
+                            (-0.7, 1.62, -0.995)], (0, 0, 1),
+             emissive(gltf, "slit", (1.0, 0.95, 0.9), 400.0))
+    add_box(gltf, "block", white, (0.3, 0.3, 0.0), (0.4, 0.6, 0.4), yaw=30.0)
+    add_sphere(gltf, "ball", gs.lambertian(gltf, "matte yellow", (0.8, 0.7, 0.2)),
+               (-0.4, 0.25, 0.3), 0.25)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+def small_lamps(gltf, colours, positions, radius, strength):
+    for i, (colour, position) in enumerate(zip(colours, positions)):
+        add_sphere(gltf, "lamp %d" % i, emissive(gltf, "lamp %d" % i, colour, strength), position,
+                   radius)
+
+
+@scene
+def night_lamps(directory):
+    """Five small, very bright coloured lamps over a plank ground at night, a crate and a chrome
+    sphere that mirrors them: tiny lights seen directly and in a mirror."""
+    gltf = gs.Gltf("night-lamps")
+    ground = textured(gltf, "planks", planks_png(), roughness=0.6)
+    add_quad(gltf, "ground", [(-5, 0, 5), (5, 0, 5), (5, 0, -5), (-5, 0, -5)], (0, 1, 0), ground,
+             uv_scale=(6, 6))
+    small_lamps(gltf, [(1, 0.5, 0.2), (0.3, 0.5, 1), (0.4, 1, 0.4), (1, 0.3, 0.6), (1, 1, 0.8)],
+                [(-1.2, 0.9, -0.5), (0.9, 1.4, -1.0), (0.2, 0.4, 0.6), (-0.4, 1.8, -1.6),
+                 (1.5, 0.3, 0.4)], 0.04, 300.0)
+    add_box(gltf, "crate", gs.lambertian(gltf, "grey", (0.5, 0.5, 0.5)), (-0.3, 0.3, -0.4),
+            (0.6, 0.6, 0.6), yaw=20.0)
+    add_sphere(gltf, "chrome", gltf.material("chrome", (0.95, 0.95, 0.95), 1.0, 0.05),
+               (0.6, 0.35, 0.1), 0.35)
+    add_camera(gltf, (0.0, 1.2, 3.5), (0.0, 0.5, -0.3), 45.0, 1.5)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+@scene
+def mirror_room(directory):
+    """The Cornell room with a mirror on the left wall, a small ceiling light, a rough gold
+    sphere and a green glass block: long specular chains."""
+    gltf = gs.Gltf("mirror-room")
+    cornell_room(gltf)
+    add_quad(gltf, "mirror", [(-0.99, 0.2, -0.8), (-0.99, 0.2, 0.6), (-0.99, 1.8, 0.6),
+                              (-0.99, 1.8, -0.8)], (1, 0, 0),
+             gltf.material("mirror", (0.95, 0.95, 0.95), 1.0, 0.02))
+    s = 0.15
+    add_quad(gltf, "light", [(-s, 1.995, -s), (s, 1.995, -s), (s, 1.995, s), (-s, 1.995, s)],
+             (0, -1, 0), emissive(gltf, "light", (1.0, 0.9, 0.8), 60.0))
+    add_sphere(gltf, "gold", gltf.material("gold", (1.0, 0.78, 0.34), 1.0, 0.25), (0.3, 0.4, 0.0),
+               0.4)
+    add_box(gltf, "glass block", glass(gltf, "glass", (0.9, 1.0, 0.9)), (-0.4, 0.3, 0.4),
+            (0.35, 0.6, 0.35), yaw=25.0)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+@scene
+def window_bars(directory):
+    """A room whose back wall holds three thin, bright vertical light bars (a window's panes
+    between mullions) seen directly, a brushed-metal sphere and a glossy box on a plank floor."""
+    gltf = gs.Gltf("window-bars")
+    cornell_room(gltf, textured(gltf, "planks", planks_png(), roughness=0.5))
+    bar = emissive(gltf, "daylight bar", (0.9, 0.95, 1.0), 120.0)
+    for i, x in enumerate((-0.45, -0.05, 0.35)):
+        add_quad(gltf, "bar %d" % i, [(x, 0.7, -0.995), (x + 0.035, 0.7, -0.995),
+                                      (x + 0.035, 1.7, -0.995), (x, 1.7, -0.995)], (0, 0, 1), bar)
+    add_sphere(gltf, "brushed", gltf.material("brushed steel", (0.8, 0.8, 0.82), 1.0, 0.15),
+               (-0.35, 0.35, 0.2), 0.35)
+    add_box(gltf, "glossy box", gltf.material("glossy red", (0.6, 0.08, 0.06), 0.0, 0.1),
+            (0.4, 0.25, 0.3), (0.4, 0.5, 0.4), yaw=-25.0)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+@scene
+def chrome_candles(directory):
+    """Seven tiny warm lamps (candle flames) around a chrome ball, a glass sphere and a gold
+    cylinder-like box on a noise-textured table, nothing else lit: small lights seen directly,
+    in a mirror and through glass."""
+    gltf = gs.Gltf("chrome-candles")
+    table = textured(gltf, "noise table", noise_png(), roughness=0.8)
+    add_quad(gltf, "table", [(-3, 0, 3), (3, 0, 3), (3, 0, -3), (-3, 0, -3)], (0, 1, 0), table,
+             uv_scale=(4, 4))
+    small_lamps(gltf, [(1.0, 0.7, 0.35)] * 7,
+                [(-1.0, 0.35, 0.3), (-0.6, 0.3, -0.7), (0.0, 0.4, -1.0), (0.7, 0.3, -0.6),
+                 (1.1, 0.35, 0.4), (0.4, 0.3, 0.9), (-0.5, 0.3, 0.9)], 0.025, 500.0)
+    add_sphere(gltf, "chrome ball", gltf.material("chrome", (0.95, 0.95, 0.95), 1.0, 0.03),
+               (0.0, 0.3, 0.0), 0.3)
+    add_sphere(gltf, "glass ball", glass(gltf, "glass", (1.0, 1.0, 1.0)), (-0.6, 0.2, 0.1), 0.2)
+    add_box(gltf, "gold block", gltf.material("gold", (1.0, 0.78, 0.34), 1.0, 0.2),
+            (0.55, 0.2, 0.1), (0.25, 0.4, 0.25), yaw=15.0)
+    add_camera(gltf, (0.0, 1.1, 2.6), (0.0, 0.2, 0.0), 42.0, 1.5)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
 def main():
     if len(sys.argv) != 2:
         sys.stderr.write("usage: generate_corpus_scenes.py OUTPUT_DIR\n")

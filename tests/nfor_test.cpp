@@ -130,10 +130,10 @@ TEST(Nfor, SelectionKneePutsBrightPixelsOnTheRelativeScale) {
 }
 
 TEST(Nfor, RequirementsRegistryAndParameters) {
-  test::expectCreates("nfor:k1=0.4:k2=1.2:regressionR=7:selectionKnee=0", "nfor",
+  test::expectCreates("nfor:k1=0.4:k2=1.2:regressionR=7:selectionKnee=0:varianceKnee=64", "nfor",
                       {.features = true, .halves = true});
-  test::expectRejected(
-      {"nfor:bandwidth=1", "nfor:k1=0", "nfor:regressionR=-1", "nfor:selectionKnee=-1"});
+  test::expectRejected({"nfor:bandwidth=1", "nfor:k1=0", "nfor:regressionR=-1",
+                        "nfor:selectionKnee=-1", "nfor:varianceKnee=-1", "nfor:varianceKnee=nan"});
   test::expectNeedsHalves(NforDenoiser());
 }
 

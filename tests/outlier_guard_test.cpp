@@ -246,6 +246,45 @@ TEST(OutlierGuard, SpreadStaysOnTheOutliersSurface) {
   EXPECT_LT(onSurface, 0.999 * before);  // some of the spread did cross the edge
 }
 
+// causticUpToAnEdge(2) (one depth everywhere) with the pixels beyond x = 20 of another albedo
+// or facing another way: a thin light set into a wall (black albedo at the wall's depth), a
+// highlight on a curved mirror (the same depth, other normals).
+SubBuffer causticBesideAnotherMaterial(bool albedoDiffers, bool normalDiffers) {
+  SubBuffer s = causticUpToAnEdge(2.0f);
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 40; ++x) {
+      const bool beyond = x >= 20;
+      for (int c = 0; c < 3; ++c) {
+        s.albedo.mean(x, y, c) = beyond && albedoDiffers ? 0.0f : 0.75f;
+        s.normal.mean(x, y, c) = c == (beyond && normalDiffers ? 0 : 2) ? 1.0f : 0.0f;
+      }
+    }
+  return s;
+}
+
+TEST(OutlierGuard, SpreadStaysOnTheOutliersMaterialAndOrientation) {
+  // One depth everywhere: beyond x = 20 receives part of the spread when albedo and normal
+  // match (the image keeps its energy), and little or nothing when either differs; the surface
+  // receives the same either way (the other side's shares are dropped, not moved onto it).
+  const SubBuffer same = causticBesideAnotherMaterial(false, false);
+  const GuardedInput one = guardOutliers(wholeOnly(same));
+  const double before = channelSum(same.color.mean);
+  const double onSurface = sumLeftOf(one.input.whole.color.mean, 20);
+  const double beyond = channelSum(one.input.whole.color.mean) - onSurface;
+  ASSERT_GT(one.clampedValues, 0u);
+  EXPECT_NEAR(onSurface + beyond, before, 1e-5 * before);
+  ASSERT_GT(beyond, 1.0);  // the spread did reach the other side
+  for (const auto& [albedo, normal] : {std::pair{true, false}, std::pair{false, true}}) {
+    const GuardedInput g = guardOutliers(wholeOnly(causticBesideAnotherMaterial(albedo, normal)));
+    EXPECT_EQ(g.clampedValues, one.clampedValues) << albedo << normal;
+    const double surface = sumLeftOf(g.input.whole.color.mean, 20);
+    EXPECT_NEAR(surface, onSurface, 1e-5 * onSurface) << albedo << normal;
+    // A black albedo beside 0.75 is a relative difference of 1: at most e^−2 of the shares.
+    EXPECT_LT(channelSum(g.input.whole.color.mean) - surface, (albedo ? 0.14 : 0.01) * beyond)
+        << albedo << normal;
+  }
+}
+
 TEST(OutlierGuard, ASparkleOnAThinSurfaceIsNotSmearedAlongIt) {
   // A one-pixel-wide strip at depth 2 (x = 20) across a background at depth 10 that holds a
   // caustic (peers for every outlier), and one sparkle on the strip: a sample of 300 among

@@ -101,6 +101,38 @@ double sameSurface(double a, double b) {
   return std::exp(-0.5 * d * d);
 }
 
+// How much a pixel of albedo b shares the material of an outlier of albedo a: a Gaussian in
+// their largest channel difference relative to the brighter (σ kSpreadAlbedoSigma). Depth
+// alone took a thin light set into a wall (black albedo, the wall's depth) for the wall: the
+// light's unconfirmed samples were spread over the wall as a haze.
+constexpr double kSpreadAlbedoSigma = 0.5;
+double sameMaterial(const Image& albedo, int ax, int ay, int bx, int by) {
+  double d = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const double a = albedo(ax, ay, c), b = albedo(bx, by, c);
+    const double scale = std::max(std::abs(a), std::abs(b));
+    if (!std::isfinite(a) || !std::isfinite(b)) return 1.0;
+    if (scale > 0.0) d = std::max(d, std::abs(a - b) / scale);
+  }
+  d /= kSpreadAlbedoSigma;
+  return std::exp(-0.5 * d * d);
+}
+
+// How much a pixel of normal b faces the way an outlier of normal a does: a Gaussian in the
+// length of their difference (σ kSpreadNormalSigma). A highlight of a small light on a curved
+// mirror belongs to the few pixels whose normal reflects the light; depth alone spread it over
+// the whole sphere as a glow.
+constexpr double kSpreadNormalSigma = 0.1;
+double sameOrientation(const Image& normal, int ax, int ay, int bx, int by) {
+  double d2 = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const double d = double(normal(ax, ay, c)) - normal(bx, by, c);
+    d2 += d * d;
+  }
+  if (!std::isfinite(d2)) return 1.0;
+  return std::exp(-0.5 * d2 / (kSpreadNormalSigma * kSpreadNormalSigma));
+}
+
 // The value exceeded by exactly `rank` of values[0 … count) (0: the largest), for a small rank:
 // the running top rank + 1 in insertion order.
 float largest(const float* values, int count, int rank) {
@@ -282,6 +314,10 @@ class PartGuard {
     });
     const Image& depth = part_.depth.mean;
     const bool hasDepth = depth.sameSize(part_.color.mean);
+    const Image& albedo = part_.albedo.mean;
+    const bool hasAlbedo = albedo.sameSize(part_.color.mean);
+    const Image& normal = part_.normal.mean;
+    const bool hasNormal = normal.sameSize(part_.color.mean);
     parallelRows(0, h, [&](int y) {
       // The excesses whose windows can reach row y: e.y within kMaxGuardSpread of it.
       auto first = std::lower_bound(excesses.begin(), excesses.end(), y - kMaxGuardSpread,
@@ -295,7 +331,9 @@ class PartGuard {
         const double total = totals[size_t(it - excesses.begin())];
         for (int x = std::max(0, e.x - r); x <= std::min(w - 1, e.x + r); ++x) {
           const double share = g[size_t(dy * (r + 1) + std::abs(x - e.x))] *
-                               (hasDepth ? sameSurface(here, depth(x, y, 0)) : 1.0) / total;
+                               (hasDepth ? sameSurface(here, depth(x, y, 0)) : 1.0) *
+                               (hasAlbedo ? sameMaterial(albedo, e.x, e.y, x, y) : 1.0) *
+                               (hasNormal ? sameOrientation(normal, e.x, e.y, x, y) : 1.0) / total;
           float& m = out.mean(x, y, e.c);
           m = float(std::min(double(m) + e.amount * share, double(kMaxFloat)));
           changed[size_t(y) * size_t(w) + size_t(x)] = 1;

@@ -18,8 +18,9 @@
 // becomes S's mean without its largest sample (see withoutLargestSample; L for a single
 // sample), kept within [min(0, L), T]; its variance of the mean min(v, max(σ_N², (x' − L)²)).
 // What it had above that is dropped when the outlier is alone, but spread over the
-// (2 R + 1)² window around it (Gaussian weights, σ = R / 2, times a Gaussian in the relative
-// depth difference: the same surface only) when it has peers: x − L ≤ peerSigmas × the RMS
+// (2 R + 1)² window around it (Gaussian weights, σ = R / 2, times Gaussians in the relative
+// depth and albedo differences and in the normals' difference: what the outlier's pixel sees
+// only; what would fall elsewhere is dropped) when it has peers: x − L ≤ peerSigmas × the RMS
 // deviation of the neighbours from L, i.e. a few neighbours deviate as much. Such outliers are
 // the samples of a heavy-tailed distribution that is really there (caustic paths): dropping
 // them would darken the caustic at any sample count the guard still acts at; spread, they keep

@@ -39,6 +39,8 @@ NforParams NforParams::fromParams(ParamMap& map) {
   p.minCenterWeight = map.getFloat("minCenterWeight", p.minCenterWeight);
   p.selectionKnee = map.getFloat("selectionKnee", p.selectionKnee);
   if (!validKnee(p.selectionKnee)) throw Error("nfor: selectionKnee must be 0 (off) or positive");
+  p.varianceKnee = map.getFloat("varianceKnee", p.varianceKnee);
+  if (!validKnee(p.varianceKnee)) throw Error("nfor: varianceKnee must be 0 (off) or positive");
   for (int v : {p.prefilterF, p.prefilterR, p.regressionF, p.regressionR, p.mseF, p.mseR,
                 p.finalFeatureF, p.finalFeatureR, p.finalF, p.finalR})
     if (v < 0 || v > 32) throw Error("nfor: patch and window radii must be in [0, 32]");
@@ -154,8 +156,11 @@ class NforRun {
 
     // Regression passes (§5.2): colour of one half, weights from the other half's colour,
     // regressed on the other half's filtered features.
-    const std::array<Image, 2> y1 = regressBothBandwidths(c1, fFiltered[1], c2, sigma2);
-    const std::array<Image, 2> y2 = regressBothBandwidths(c2, fFiltered[0], c1, sigma2);
+    const double knee = kneeLevel({c.data(), c.size()}, p_.varianceKnee);
+    const std::array<Image, 2> y1 =
+        regressBothBandwidths(c1, fFiltered[1], c2, kneed(sigma2, c2, knee));
+    const std::array<Image, 2> y2 =
+        regressBothBandwidths(c2, fFiltered[0], c1, kneed(sigma2, c1, knee));
     const Image selection = selectionMap(c, c1, c2, sigma2, y1, y2);
     return {blend(y1[0], y1[1], selection), blend(y2[0], y2[1], selection)};
   }
@@ -186,7 +191,9 @@ class NforRun {
     const Image rMean = pixelMean(r[0], r[1]);
     const Image rMeanVar =
         combine(r[0], r[1], [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
-    return regress(rMean, fFinal, rMean, rMeanVar, p_.finalF, p_.finalK, p_.finalR);
+    const double knee = kneeLevel({rMean.data(), rMean.size()}, p_.varianceKnee);
+    return regress(rMean, fFinal, rMean, kneed(rMeanVar, rMean, knee), p_.finalF, p_.finalK,
+                   p_.finalR);
   }
 
   Image finalFeatures(const std::array<Image, 2>& fFiltered) const {
@@ -296,6 +303,12 @@ class NforRun {
       out.data()[i] = std::isfinite(e) ? e : 0.0f;
     }
     return out;
+  }
+
+  // `variance` with each pixel above the knee divided by its divisor at guide's level.
+  static Image kneed(Image variance, const Image& guide, double knee) {
+    if (knee > 0.0) divideByPixel(variance, kneeDivisors(guide, knee));
+    return variance;
   }
 
   static Image blend(const Image& a, const Image& b, const Image& t) {

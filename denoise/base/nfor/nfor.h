@@ -43,6 +43,13 @@ struct NforParams {
   // Not Tungsten's: pixels brighter than this times the image's mean |colour| enter the MSE
   // smoothing of step 3 scaled down to that level (relative error above it); 0 = Tungsten's.
   float selectionKnee = 16.0f;
+  // Not Tungsten's, off by default: above this times the image's mean |colour| a pixel's
+  // colour variance is divided by (level / that)² in both passes' regression weights, so that
+  // a bright pixel's noise no longer excuses its difference from dark neighbours
+  // (selection_knee.h). 64 takes NFOR alone from 2.4 to 0.11 relMSE on a thin light at 4 spp
+  // and 0.894 / 0.982 of its error on the corpus's halves, but the ensembles blend 1.0005×
+  // worse on the validation half (docs/members/nfor-nlm.md); 0 = Tungsten's.
+  float varianceKnee = 0.0f;
 
   // Reads overrides (keys = the field names above); unread keys stay in the map.
   static NforParams fromParams(ParamMap& map);

@@ -106,13 +106,12 @@ double sameSurface(double a, double b) {
 // alone took a thin light set into a wall (black albedo, the wall's depth) for the wall: the
 // light's unconfirmed samples were spread over the wall as a haze.
 constexpr double kSpreadAlbedoSigma = 0.5;
-double sameMaterial(const Image& albedo, int ax, int ay, int bx, int by) {
+double sameMaterial(const float* a, const float* b) {
   double d = 0.0;
   for (int c = 0; c < 3; ++c) {
-    const double a = albedo(ax, ay, c), b = albedo(bx, by, c);
-    const double scale = std::max(std::abs(a), std::abs(b));
-    if (!std::isfinite(a) || !std::isfinite(b)) return 1.0;
-    if (scale > 0.0) d = std::max(d, std::abs(a - b) / scale);
+    if (!std::isfinite(a[c]) || !std::isfinite(b[c])) return 1.0;
+    const double scale = std::max(std::abs(double(a[c])), std::abs(double(b[c])));
+    if (scale > 0.0) d = std::max(d, std::abs(double(a[c]) - b[c]) / scale);
   }
   d /= kSpreadAlbedoSigma;
   return std::exp(-0.5 * d * d);
@@ -123,10 +122,10 @@ double sameMaterial(const Image& albedo, int ax, int ay, int bx, int by) {
 // mirror belongs to the few pixels whose normal reflects the light; depth alone spread it over
 // the whole sphere as a glow.
 constexpr double kSpreadNormalSigma = 0.1;
-double sameOrientation(const Image& normal, int ax, int ay, int bx, int by) {
+double sameOrientation(const float* a, const float* b) {
   double d2 = 0.0;
   for (int c = 0; c < 3; ++c) {
-    const double d = double(normal(ax, ay, c)) - normal(bx, by, c);
+    const double d = double(a[c]) - b[c];
     d2 += d * d;
   }
   if (!std::isfinite(d2)) return 1.0;
@@ -327,13 +326,16 @@ class PartGuard {
         const int r = e.radius, dy = std::abs(y - e.y);
         if (dy > r) continue;
         const std::vector<double>& g = kernels.byRadius[size_t(r)];
+        // What the outlier's pixel sees (features the input does not hold count as the same).
         const double here = hasDepth ? depth(e.x, e.y, 0) : 0.0;
+        const float* material = hasAlbedo ? albedo.pixel(e.x, e.y) : nullptr;
+        const float* facing = hasNormal ? normal.pixel(e.x, e.y) : nullptr;
         const double total = totals[size_t(it - excesses.begin())];
         for (int x = std::max(0, e.x - r); x <= std::min(w - 1, e.x + r); ++x) {
           const double share = g[size_t(dy * (r + 1) + std::abs(x - e.x))] *
                                (hasDepth ? sameSurface(here, depth(x, y, 0)) : 1.0) *
-                               (hasAlbedo ? sameMaterial(albedo, e.x, e.y, x, y) : 1.0) *
-                               (hasNormal ? sameOrientation(normal, e.x, e.y, x, y) : 1.0) / total;
+                               (material ? sameMaterial(material, albedo.pixel(x, y)) : 1.0) *
+                               (facing ? sameOrientation(facing, normal.pixel(x, y)) : 1.0) / total;
           float& m = out.mean(x, y, e.c);
           m = float(std::min(double(m) + e.amount * share, double(kMaxFloat)));
           changed[size_t(y) * size_t(w) + size_t(x)] = 1;

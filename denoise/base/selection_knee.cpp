@@ -31,4 +31,9 @@ void divideByPixel(Image& rgb, std::span<const float> divisors) {
   for (size_t k = 0; k < rgb.size(); ++k) rgb.data()[k] /= divisors[k / 3];
 }
 
+Image kneedVariance(Image variance, const Image& guide, double kneeLevel) {
+  if (kneeLevel > 0) divideByPixel(variance, kneeDivisors(guide, kneeLevel));
+  return variance;
+}
+
 }  // namespace chorus

@@ -37,6 +37,10 @@ inline double rgbLevel(const Image& rgb, size_t pixel) {
 std::vector<float> kneeDivisors(const Image& rgb, double kneeLevel);
 // Every value of an RGB image divided by its pixel's divisor.
 void divideByPixel(Image& rgb, std::span<const float> divisors);
+// A colour variance (RGB) with every pixel above the knee divided by its divisor at `guide`'s
+// level: its noise no longer excuses its difference from a dark neighbour in patch distances or
+// weights. Returned as it is when kneeLevel ≤ 0 (the knee is off).
+Image kneedVariance(Image variance, const Image& guide, double kneeLevel);
 
 // Every error map's element e divided by kneeDivisor(level(e), kneeLevel), for e < count; an
 // element at FLT_MAX (a member's mark for "unusable") stays. NFOR: its two bandwidths' MSE maps,

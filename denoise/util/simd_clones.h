@@ -10,15 +10,15 @@
 // vectorised loop) gives the same bits.
 // -DCHORUS_NO_AVX512=ON (CMake) leaves the AVX-512 clones out and makes cpuHasAvx512f false: an
 // AVX-512 machine then runs what an AVX2 CPU runs.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(CHORUS_NO_AVX512)
-#define CHORUS_SIMD_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#ifdef CHORUS_NO_AVX512
+#define CHORUS_CLONE_TARGETS "arch=x86-64-v3", "default"
+#else
+#define CHORUS_CLONE_TARGETS "avx512f", "arch=x86-64-v3", "default"
+#endif
+#define CHORUS_SIMD_CLONES __attribute__((target_clones(CHORUS_CLONE_TARGETS)))
 #define CHORUS_SIMD_CLONES_EXACT \
-  __attribute__((target_clones("arch=x86-64-v3", "default"), optimize("fp-contract=off")))
-#elif defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define CHORUS_SIMD_CLONES __attribute__((target_clones("avx512f", "arch=x86-64-v3", "default")))
-#define CHORUS_SIMD_CLONES_EXACT                                        \
-  __attribute__((target_clones("avx512f", "arch=x86-64-v3", "default"), \
-                 optimize("fp-contract=off")))
+  __attribute__((target_clones(CHORUS_CLONE_TARGETS), optimize("fp-contract=off")))
 #else
 #define CHORUS_SIMD_CLONES
 #define CHORUS_SIMD_CLONES_EXACT

@@ -55,15 +55,6 @@ float largestFiniteValue(const Image& image) {
   return largest > 0.0f ? largest : 1.0f;
 }
 
-// The colour variance the patch distances divide by, a bright pixel's (its guide's level above
-// the knee) divided by (level / knee)²: its noise no longer excuses its difference from a dark
-// neighbour. Cross-filtered at few samples, a highlight's pixels looked like the dark pixels beside
-// them to the other half's weights, which then averaged this half's highlight into them.
-Image kneedVariance(Image variance, const Image& guide, double kneeLevel) {
-  divideByPixel(variance, kneeDivisors(guide, kneeLevel));
-  return variance;
-}
-
 void require(bool ok, const std::string& what) {
   if (!ok) throw Error("jnlm: " + what);
 }
@@ -115,6 +106,9 @@ Image runJointNlMeans(const DenoiseInput& input, const JointNlMeansParams& param
     return std::move(featureNlMeans(images, &patch, features, window)[0]);
   };
 
+  // The variance the patch distances divide by, kneed (selection_knee.h): cross-filtered at few
+  // samples, a highlight's pixels looked like the dark pixels beside them to the other half's
+  // weights, which then averaged this half's highlight into them.
   const double knee =
       kneeLevel({whole.color.mean.data(), whole.color.mean.size()}, params.varianceKnee);
   Image out;

@@ -158,9 +158,9 @@ class NforRun {
     // regressed on the other half's filtered features.
     const double knee = kneeLevel({c.data(), c.size()}, p_.varianceKnee);
     const std::array<Image, 2> y1 =
-        regressBothBandwidths(c1, fFiltered[1], c2, kneed(sigma2, c2, knee));
+        regressBothBandwidths(c1, fFiltered[1], c2, kneedVariance(sigma2, c2, knee));
     const std::array<Image, 2> y2 =
-        regressBothBandwidths(c2, fFiltered[0], c1, kneed(sigma2, c1, knee));
+        regressBothBandwidths(c2, fFiltered[0], c1, kneedVariance(sigma2, c1, knee));
     const Image selection = selectionMap(c, c1, c2, sigma2, y1, y2);
     return {blend(y1[0], y1[1], selection), blend(y2[0], y2[1], selection)};
   }
@@ -192,7 +192,7 @@ class NforRun {
     const Image rMeanVar =
         combine(r[0], r[1], [](float a, float b) { return (b - a) * (b - a) * 0.25f; });
     const double knee = kneeLevel({rMean.data(), rMean.size()}, p_.varianceKnee);
-    return regress(rMean, fFinal, rMean, kneed(rMeanVar, rMean, knee), p_.finalF, p_.finalK,
+    return regress(rMean, fFinal, rMean, kneedVariance(rMeanVar, rMean, knee), p_.finalF, p_.finalK,
                    p_.finalR);
   }
 
@@ -303,12 +303,6 @@ class NforRun {
       out.data()[i] = std::isfinite(e) ? e : 0.0f;
     }
     return out;
-  }
-
-  // `variance` with each pixel above the knee divided by its divisor at guide's level.
-  static Image kneed(Image variance, const Image& guide, double knee) {
-    if (knee > 0.0) divideByPixel(variance, kneeDivisors(guide, knee));
-    return variance;
   }
 
   static Image blend(const Image& a, const Image& b, const Image& t) {

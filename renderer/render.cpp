@@ -12,6 +12,7 @@
 #include "common/stopwatch.h"
 #include "common/thread_limit.h"
 #include "renderer/integrator/camera.h"
+#include "renderer/integrator/emission_pass.h"
 #include "renderer/integrator/film.h"
 #include "renderer/integrator/lane_tracer.h"
 #include "renderer/integrator/lights.h"
@@ -36,6 +37,9 @@ void validate(const RenderOptions& o) {
     throw Error("--lens-radius must be a finite number >= 0");
   if (!(o.focusDistance >= 0) || !std::isfinite(o.focusDistance))
     throw Error("--focus-distance must be a finite number >= 0");
+  if (o.emissionSamples < 1)
+    throw Error("--emission-samples must be at least 1 (got " + std::to_string(o.emissionSamples) +
+                ")");
 }
 
 }  // namespace
@@ -98,8 +102,10 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
       laneTracer.reset();
   }
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
-  Film film = arena.execute(
-      [&] { return Film(resolution.width, resolution.height, options.splits, options.planes); });
+  Film film = arena.execute([&] {
+    return Film(resolution.width, resolution.height, options.splits, options.planes,
+                options.separateEmission);
+  });
 
   const int tilesX = (resolution.width + kTileSize - 1) / kTileSize;
   const int tilesY = (resolution.height + kTileSize - 1) / kTileSize;
@@ -121,7 +127,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
       Sampler sampler(options.seed);
       for (int y = y0; y < y1; ++y) {
         for (int x = x0; x < x1; ++x) {
-          PixelAccumulator pixel;
+          PixelAccumulator pixel(film.separatesEmission());
           for (int i = 0; i < options.spp; ++i) {
             const Ray ray = startPixelSample(sampler, camera, x, y, i, options.splits);
             if (!pixel.add(i % options.splits, tracer.trace(ray, sampler, tileRays))) ++tileDropped;
@@ -151,8 +157,20 @@ RenderResult render(const Scene& scene, const RenderOptions& options,
   });
 
   RenderResult result;
-  result.buffers = film.release();
   RenderStats& s = result.stats;
+  if (options.separateEmission) {
+    const Stopwatch pass;
+    const std::vector<uint32_t> pixels = emissionPassPixels(film);
+    PathTracer::RayCounts passRays;
+    arena.execute([&] {
+      runEmissionPass(film, pixels, tracer, camera, options.seed, options.emissionSamples,
+                      passRays);
+    });
+    rays += passRays.closestHit;
+    s.emissionPixels = pixels.size();
+    s.emissionSeconds = pass.seconds();
+  }
+  result.buffers = film.release();
   s.width = resolution.width;
   s.height = resolution.height;
   s.spp = options.spp;

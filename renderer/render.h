@@ -44,6 +44,16 @@ struct RenderOptions {
   // The planes the sub-buffers record (colour always): what the denoisers will read. The planes
   // kept are bit-identical whatever the others are.
   BufferPlanes planes = BufferPlanes::all();
+  // Emission seen directly or through mirrors and glass (PathSample::emitted) is taken out of
+  // every sample's colour and kept in SampleBuffers::emission(): the denoisers then filter only
+  // the light reflected by what the camera sees, and a small lamp's radiance cannot spread over
+  // its neighbours. Where a pixel's samples saw different emission (the edge of a light, a
+  // defocused light, glass that reflects or transmits at random), and next to such pixels, that
+  // plane is estimated again from emissionSamples camera paths followed only as far as their
+  // first surface that is not a mirror or glass (emission_pass.h): edges of lights are then
+  // resolved as well as at that many samples per pixel, at the cost of a camera ray each.
+  bool separateEmission = false;
+  int emissionSamples = 64;
 };
 
 struct RenderStats {
@@ -54,8 +64,10 @@ struct RenderStats {
   uint64_t shadowRays = 0;         // of which shadow rays
   uint64_t nanSamplesDropped = 0;  // samples with a non-finite value, not accumulated
   size_t triangles = 0;
-  bool lanes = false;       // traced by LaneTracer (four paths in SIMD lanes), else by PathTracer
-  float focusDistance = 0;  // the thin lens's, autofocus resolved (0: a pinhole)
+  bool lanes = false;  // traced by LaneTracer (four paths in SIMD lanes), else by PathTracer
+  uint64_t emissionPixels = 0;  // pixels the emission pass estimated again (separateEmission)
+  double emissionSeconds = 0;   // that pass's time (included in renderSeconds)
+  float focusDistance = 0;      // the thin lens's, autofocus resolved (0: a pinhole)
   double samplesPerSecond() const {
     return renderSeconds > 0 ? double(samples) / renderSeconds : 0;
   }

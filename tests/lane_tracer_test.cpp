@@ -91,6 +91,12 @@ TEST(LaneTracer, OpenRoomWithEveryKindOfLightBitIdentical) {
   EXPECT_GT(test::expectTracersAgree(lit, options(33, 21, 5, 1)), 0.01);
   const Scene sky = openRoom(dir, EnvironmentDesc::constant(Rgb(0.3f, 0.4f, 0.6f)));
   test::expectTracersAgree(sky, options(17, 15, 4, 2));
+  // Emission taken out of the colour: seen directly, on the black and the two-sided emitters'
+  // edges, and in the sky.
+  RenderOptions separated = options(17, 15, 4, 2);
+  separated.separateEmission = true;
+  test::expectTracersAgree(lit, separated);
+  test::expectTracersAgree(sky, separated);
   // An equirectangular map with a bright band, importance-sampled.
   const int w = 16, h = 8;
   std::vector<float> texels(size_t(w * h * 3));
@@ -108,6 +114,10 @@ TEST(LaneTracer, OpenRoomWithEveryKindOfLightBitIdentical) {
 TEST(LaneTracer, EveryOtherMaterialBitIdentical) {
   test::expectTracersAgree(loadScene(test::sourceDir() / "scenes/glass-and-metal.gltf"),
                            options(29, 23, 6, 2));
+  // Emission seen in mirrors and not through glass.
+  RenderOptions separated = options(29, 23, 6, 2);
+  separated.separateEmission = true;
+  test::expectTracersAgree(loadScene(test::sourceDir() / "scenes/glass-and-metal.gltf"), separated);
   test::expectTracersAgree(loadScene(test::sourceDir() / "scenes/punctual-lights.gltf"),
                            options(29, 23, 6, 4));
 

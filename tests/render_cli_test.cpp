@@ -351,6 +351,35 @@ TEST(RenderCli, DenoisesInProcessLikeChorusDenoiseOnTheWrittenRender) {
   EXPECT_LT(m["atrous"]["relmse"].get<double>(), m["noisy"]["relmse"].get<double>());
 }
 
+// --emission-samples: the emission layer and what stats.json says about the pass, or neither.
+TEST(RenderCli, EmissionSamplesKeepsTheEmissionApartOrNot) {
+  TempDir dir;
+  const auto scene = test::sourceDir() / "scenes" / "cornell-box.gltf";
+  auto r = runChorus({"render", scene.string(), "--width", "24", "--spp", "4", "--denoise", "none",
+                      "--out", (dir / "kept").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const std::vector<ExrLayer> kept = readExr(dir / "kept" / "render.exr");
+  const ExrLayer* emission = findLayer(kept, "emission");
+  ASSERT_NE(emission, nullptr);
+  float brightest = 0;  // the light, seen directly
+  for (float v : emission->image.values()) brightest = std::max(brightest, v);
+  EXPECT_GT(brightest, 1.0f);
+  json stats = readJson(dir / "kept" / "stats.json");
+  EXPECT_EQ(stats["emission"]["samples"], 64);
+  EXPECT_GT(stats["emission"]["pixels"].get<int>(), 0);  // the light's edges
+
+  r = runChorus({"render", scene.string(), "--width", "24", "--spp", "4", "--denoise", "none",
+                 "--emission-samples", "0", "--out", (dir / "plain").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(findLayer(readExr(dir / "plain" / "render.exr"), "emission"), nullptr);
+  EXPECT_EQ(readJson(dir / "plain" / "stats.json")["emission"], "denoised with the rest");
+
+  r = runChorus(
+      {"render", scene.string(), "--emission-samples", "-1", "--out", (dir / "bad").string()});
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("--emission-samples"), std::string::npos) << r.err;
+}
+
 // Render now, denoise later: --denoise none keeps the 4 sub-buffers the default members need, so
 // `chorus denoise --methods default` on render.exr computes exactly what the render's own default
 // denoising does.

@@ -89,27 +89,31 @@ SubBuffer readSubBuffer(const std::vector<ExrLayer>& layers, const std::string& 
 
 }  // namespace
 
-std::vector<ExrLayer> sampleBuffersToLayers(const SampleBuffers& buffers) {
+namespace {
+
+// Both overloads: Buffers is SampleBuffers (copied from) or SampleBuffers& (moved from).
+template <typename Buffers>
+std::vector<ExrLayer> toLayers(Buffers& buffers) {
   std::vector<ExrLayer> layers;
-  if (buffers.splitCount() == 1) {
+  if (buffers.splitCount() == 1 && buffers.emission().empty()) {
     appendSubBuffer(layers, buffers.sub(0), "");
     return layers;
   }
-  layers.push_back({"", buffers.part(BufferPart::Full).color.mean});
+  layers.push_back({"", buffers.noisyColor()});
+  if (!buffers.emission().empty()) layers.push_back({"emission", buffers.emission()});
   for (int k = 0; k < buffers.splitCount(); ++k)
     appendSubBuffer(layers, buffers.sub(k), "sub" + std::to_string(k) + ".");
   return layers;
 }
 
+}  // namespace
+
+std::vector<ExrLayer> sampleBuffersToLayers(const SampleBuffers& buffers) {
+  return toLayers(buffers);
+}
+
 std::vector<ExrLayer> sampleBuffersToLayers(SampleBuffers&& buffers) {
-  std::vector<ExrLayer> layers;
-  if (buffers.splitCount() == 1) {
-    appendSubBuffer(layers, buffers.sub(0), "");
-  } else {
-    layers.push_back({"", buffers.part(BufferPart::Full).color.mean});
-    for (int k = 0; k < buffers.splitCount(); ++k)
-      appendSubBuffer(layers, buffers.sub(k), "sub" + std::to_string(k) + ".");
-  }
+  std::vector<ExrLayer> layers = toLayers(buffers);
   buffers = SampleBuffers();
   return layers;
 }
@@ -129,7 +133,16 @@ SampleBuffers sampleBuffersFromLayers(const std::vector<ExrLayer>& layers,
     if (s.planes() != subs[0].planes())
       throw fileError(fileForErrors, "sub-buffers hold different layers");
   }
-  return SampleBuffers(std::move(subs));
+  SampleBuffers buffers(std::move(subs));
+  if (const Image* emission = findPlane(layers, "emission", 3, fileForErrors)) {
+    if (emission->width() != buffers.width() || emission->height() != buffers.height())
+      throw fileError(fileForErrors, "layer 'emission' differs in size from the sub-buffers");
+    for (size_t i = 0; i < emission->size(); ++i)
+      if (!(emission->data()[i] >= 0) || !std::isfinite(emission->data()[i]))
+        throw fileError(fileForErrors, "layer 'emission' holds a negative or non-finite value");
+    buffers.setEmission(*emission);
+  }
+  return buffers;
 }
 
 }  // namespace chorus

@@ -7,15 +7,20 @@
 //   sub<k>.depth, sub<k>.visibility      1 channel (Y)
 //   sub<k>.<q>Variance                   variance of the mean of each feature
 //   sub<k>.sampleCount                   samples per pixel (Y)
-//   ""                                   the full buffer's colour mean (RGB), what viewers show
-//                                        first; the rest of the full buffer is the exact merge
-//                                        of the sub-buffers and is not stored
+//   ""                                   the full buffer's colour mean (RGB) with the emission
+//                                        added, what viewers show first; the rest of the full
+//                                        buffer is the exact merge of the sub-buffers and is not
+//                                        stored
+//   emission                             when the render separated it (SampleBuffers::emission):
+//                                        what the camera sees emitted directly or through mirrors
+//                                        and glass (RGB), left out of every sub<k>.color
 //
-// With K = 1 the one buffer's layers carry no prefix: "" is its colour mean, then colorVariance,
-// albedo, … as above. Features are stored when the buffers hold them (BufferPlanes): a render
-// for members that read fewer features has fewer layers. Reading takes the sub-buffers when
-// present, otherwise the unprefixed layers as K = 1; colour and the sample count are required,
-// each feature plane is read when present.
+// With K = 1 and no emission the one buffer's layers carry no prefix: "" is its colour mean,
+// then colorVariance, albedo, … as above (with emission it is sub0, so that "" is the image).
+// Features are stored when the buffers hold them (BufferPlanes): a render for members that read
+// fewer features has fewer layers. Reading takes the sub-buffers when present, otherwise the
+// unprefixed layers as K = 1; colour and the sample count are required, each feature plane is read
+// when present.
 #include <filesystem>
 #include <vector>
 

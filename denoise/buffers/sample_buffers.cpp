@@ -208,6 +208,30 @@ SampleBuffers::SampleBuffers(std::vector<SubBuffer> subBuffers)
       throw std::invalid_argument("SampleBuffers: sub-buffers differ in size");
 }
 
+void SampleBuffers::setEmission(Image emission) {
+  if (!emission.empty() &&
+      (emission.width() != width() || emission.height() != height() || emission.channels() != 3))
+    throw std::invalid_argument("SampleBuffers: the emission plane does not match the buffers");
+  emission_ = std::move(emission);
+}
+
+Image SampleBuffers::noisyColor() const {
+  Image color = part(BufferPart::Full).color.mean;
+  addEmission(color, emission_);
+  return color;
+}
+
+void addEmission(Image& image, const Image& emission) {
+  if (emission.empty()) return;
+  if (emission.width() != image.width() || emission.height() != image.height() ||
+      emission.channels() != image.channels())
+    throw std::invalid_argument("addEmission: the emission plane does not match the image");
+  float* out = image.data();
+  const float* e = emission.data();
+  const size_t n = image.size();
+  for (size_t i = 0; i < n; ++i) out[i] += e[i];
+}
+
 SubBuffer SampleBuffers::merge(const std::vector<int>& indices) const {
   std::vector<const SubBuffer*> parts;
   for (int k : indices) parts.push_back(&sub(k));

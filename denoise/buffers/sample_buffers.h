@@ -109,6 +109,10 @@ struct DenoiseInput {
 // samples it holds (DenoiseInput::sampleShare); 0 without counts.
 double renderSamplesPerPixel(const SubBuffer& buffer, double sampleShare);
 
+// image += emission, channel for channel (nothing when emission is empty). Throws
+// std::invalid_argument when the sizes differ.
+void addEmission(Image& image, const Image& emission);
+
 // Which part of a SampleBuffers an ensemble run denoises.
 enum class BufferPart { HalfA, HalfB, Full };
 std::string_view partName(BufferPart part);  // "A", "B", "full"
@@ -134,8 +138,18 @@ class SampleBuffers {
   // quarters 2/3, full gets A/B. With K = 2 only the full buffer has halves; with K = 1 none.
   DenoiseInput input(BufferPart which) const;
 
+  // The emission the camera sees directly or through mirrors and glass (RGB), when the render
+  // took it out of every sub-buffer's colour (renderer/render.h, separateEmission); else empty.
+  // The sub-buffers' colour is then what is left to denoise, and every image of the scene is
+  // that colour (or a denoised version of it) plus this plane: see noisyColor.
+  const Image& emission() const { return emission_; }
+  void setEmission(Image emission);
+  // The full buffer's colour mean with the emission added back: the noisy image a user sees.
+  Image noisyColor() const;
+
  private:
   std::vector<SubBuffer> subBuffers_;
+  Image emission_;
 };
 
 }  // namespace chorus

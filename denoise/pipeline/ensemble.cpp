@@ -222,6 +222,7 @@ std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
         group.run([&, m, part, target, runner] {
           const Stopwatch clock;
           *target = runner->run(m);
+          addEmission(*target, sources.emission);
           seconds[m * parts + part] = clock.seconds();
           counter.finished(members[m].label + "/" + plan[part].name, seconds[m * parts + part]);
         });

@@ -58,8 +58,9 @@ bool readsHalves(std::span<const EnsembleMember> members);
 void checkMembersCanRunAlone(const DenoiseInput& input, std::span<const EnsembleMember> members);
 
 // Every member on `input` only (no runs on halves, no combination), in parallel; the outputs in
-// member order. Appends "<label>/full" (the time of each run) and "members" (wall time of all of
-// them) to `times`.
+// member order, as the members return them (a render's emission is not in `input`: add it,
+// SampleBuffers::emission). Appends "<label>/full" (the time of each run) and "members" (wall
+// time of all of them) to `times`.
 std::vector<Image> runMembersAlone(const DenoiseInput& input,
                                    std::span<const EnsembleMember> members,
                                    std::vector<StageTime>* times = nullptr,
@@ -104,7 +105,8 @@ bool blendsFullRuns(int width, int height, double samplesPerPixel);
 inline constexpr long kWideWindowPixels = 131072;  // 2^17, e.g. 512 x 256
 CombineOptions optionsForRuns(CombineOptions options, const BaseRuns& runs,
                               std::span<const EnsembleMember> members, int width, int height);
-// Every member on the runs that `runs` asks for, in parallel. Appends "<label>/A",
+// Every member on the runs that `runs` asks for, in parallel, each output with the sources'
+// emission added back. Appends "<label>/A",
 // "<label>/B", "<label>/full", "<label>/without-q<k>" (the time of each run) and "bases" (wall
 // time of all of them) to `times`; reports each run's end to `progress`.
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,

@@ -16,8 +16,11 @@ void checkSplitCount(int k) {
 
 EnsembleSources sourcesFromBuffers(const SampleBuffers& buffers, bool halvesOfFull) {
   checkSplitCount(buffers.splitCount());
-  EnsembleSources sources{buffers.input(BufferPart::HalfA), buffers.input(BufferPart::HalfB), {}};
+  EnsembleSources sources;
+  sources.a = buffers.input(BufferPart::HalfA);
+  sources.b = buffers.input(BufferPart::HalfB);
   sources.full.whole = buffers.part(BufferPart::Full);
+  sources.emission = buffers.emission();
   if (halvesOfFull) addHalvesOfFull(sources);
   return sources;
 }
@@ -27,7 +30,9 @@ std::array<SubBuffer, 2> fullBufferHalves(const EnsembleSources& sources) {
   return {sources.a.whole, sources.b.whole};
 }
 
-void addHalvesOfFull(EnsembleSources& sources) { sources.full.halves = fullBufferHalves(sources); }
+void addHalvesOfFull(EnsembleSources& sources) {
+  sources.full.halves = fullBufferHalves(sources);
+}
 
 EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull) {
   const int k = buffers.splitCount();
@@ -42,6 +47,7 @@ EnsembleSources sourcesFromBuffers(SampleBuffers&& buffers, bool halvesOfFull) {
     sources.a = buffers.input(BufferPart::HalfA);
     sources.b = buffers.input(BufferPart::HalfB);
   }
+  sources.emission = buffers.emission();
   if (halvesOfFull) addHalvesOfFull(sources);
   buffers = {};
   return sources;
@@ -74,6 +80,10 @@ EnsembleGuides guidesFromSources(const EnsembleSources& sources, bool withQuarte
   if (withQuarters && sources.a.halves && sources.b.halves)
     for (const DenoiseInput* half : {&sources.a, &sources.b})
       for (const SubBuffer& quarter : *half->halves) guides.quarters.push_back(quarter.color.mean);
+  addEmission(guides.color, sources.emission);
+  addEmission(guides.colorA, sources.emission);
+  addEmission(guides.colorB, sources.emission);
+  for (Image& quarter : guides.quarters) addEmission(quarter, sources.emission);
   guides.albedo = sources.full.whole.albedo.mean;
   guides.normal = sources.full.whole.normal.mean;
   return guides;

@@ -13,6 +13,10 @@ namespace chorus {
 // on A must not see B: the MSE estimate relies on y^A being independent of x^B).
 struct EnsembleSources {
   DenoiseInput a, b, full;
+  // The emission the inputs' colour leaves out (SampleBuffers::emission; empty when none): every
+  // member run's output and every noisy guide gets it added back, so that the ensemble weighs
+  // and blends images of the whole scene while the members filter only the rest.
+  Image emission;
   int width() const { return full.width(); }
   int height() const { return full.height(); }
 };
@@ -38,7 +42,8 @@ EnsembleSources sourcesFromHalves(const DenoiseInput& input);
 
 // The noisy colour of the full buffer, both halves (through the outlier guard, as the members
 // see them: denoise/base/outlier_guard.h), and the full buffer's albedo and normal; with
-// `withQuarters` and K = 4 also the four quarters (each guarded on its own samples).
+// `withQuarters` and K = 4 also the four quarters (each guarded on its own samples). The
+// sources' emission is added to every noisy colour.
 EnsembleGuides guidesFromSources(const EnsembleSources& sources, bool withQuarters = false);
 
 }  // namespace chorus

@@ -19,18 +19,29 @@ std::array<float, kPathSampleChannels> channels(const PathSample& s) {
 
 bool PathSample::isFinite() const {
   // A sum of floats taken in double cannot overflow, so it is finite exactly when every term is
-  // (one test instead of eleven).
-  double sum = 0;
+  // (one test instead of fourteen).
+  double sum = double(emitted.r) + double(emitted.g) + double(emitted.b);
   for (float v : channels(*this)) sum += double(v);
   return std::isfinite(sum);
 }
 
 bool PixelAccumulator::add(int k, const PathSample& sample) {
   if (!sample.isFinite()) return false;
+  if (kept_++ == 0) firstEmitted_ = sample.emitted;
+  for (int c = 0; c < 3; ++c) {
+    const float e = sample.emitted[c], first = firstEmitted_[c];
+    if (e != first) emittedVaries_ = true;
+    emittedSum_[size_t(c)] += double(e);
+  }
   Stats& s = stats_[size_t(k)];
   ++s.count;
   const double rcpCount = 1.0 / double(s.count);  // one division for all channels
-  const auto values = channels(sample);
+  auto values = channels(sample);
+  if (separateEmission_) {
+    values[0] -= sample.emitted.r;
+    values[1] -= sample.emitted.g;
+    values[2] -= sample.emitted.b;
+  }
   for (size_t c = 0; c < values.size(); ++c) {
     // Welford: mean_n = mean_{n−1} + δ/n, M2_n = M2_{n−1} + δ (x − mean_n).
     const double x = values[c];
@@ -41,8 +52,11 @@ bool PixelAccumulator::add(int k, const PathSample& sample) {
   return true;
 }
 
-Film::Film(int width, int height, int splits, BufferPlanes planes)
-    : width_(width), height_(height), planes_(planes | BufferPlanes::colorOnly()) {
+Film::Film(int width, int height, int splits, BufferPlanes planes, bool separateEmission)
+    : width_(width),
+      height_(height),
+      planes_(planes | BufferPlanes::colorOnly()),
+      separateEmission_(separateEmission) {
   if (splits != 1 && splits != 2 && splits != 4)
     throw std::invalid_argument("Film: splits must be 1, 2 or 4");
   // Allocated and zeroed on as many threads as there are sub-buffers: the first touch of 24 MB
@@ -50,6 +64,10 @@ Film::Film(int width, int height, int splits, BufferPlanes planes)
   subBuffers_.resize(size_t(splits));
   tbb::parallel_for(
       0, splits, [&](int k) { subBuffers_[size_t(k)] = SubBuffer::zeros(width, height, planes_); });
+  if (separateEmission) {
+    emission_ = Image(width, height, 3);
+    emittedVaries_.assign(size_t(width) * size_t(height), 0);
+  }
 }
 
 void Film::store(int x, int y, const PixelAccumulator& pixel) {
@@ -77,10 +95,31 @@ void Film::store(int x, int y, const PixelAccumulator& pixel) {
     }
     sub.sampleCount(x, y, 0) = float(s.count);
   }
+  if (separateEmission_) {
+    const Rgb e = pixel.emitted();
+    float* out = emission_.pixel(x, y);
+    out[0] = e.r, out[1] = e.g, out[2] = e.b;
+    emittedVaries_[size_t(y) * size_t(width_) + size_t(x)] = pixel.emittedVaries() ? 1 : 0;
+  }
+}
+
+double Film::samplesKept(int x, int y) const {
+  double n = 0;
+  for (const SubBuffer& sub : subBuffers_) n += sub.sampleCount(x, y, 0);
+  return n;
+}
+
+Rgb PixelAccumulator::emitted() const {
+  if (kept_ == 0) return Rgb(0.0f);
+  return {float(emittedSum_[0] / kept_), float(emittedSum_[1] / kept_),
+          float(emittedSum_[2] / kept_)};
 }
 
 SampleBuffers Film::release() {
-  return SampleBuffers(std::move(subBuffers_));
+  SampleBuffers buffers(std::move(subBuffers_));
+  buffers.setEmission(std::move(emission_));
+  emittedVaries_ = {};
+  return buffers;
 }
 
 }  // namespace chorus::render

@@ -85,6 +85,8 @@ struct LaneFrame {
 struct Paths {
   L::Vec3 origin, direction;
   L::Vec3 radiance, beta;
+  L::Vec3 emitted;   // the part of radiance seen directly or through mirrors
+  Mask emittedOpen;  // whether emission reached now goes to `emitted` (PathTracer::trace)
   Float previousPdf, pathLength;
   Float etaScale;  // radiance scaling by refraction, removed for roulette decisions
   Mask previousDelta;
@@ -100,6 +102,8 @@ struct Paths {
     origin.set(i, ray.origin);
     direction.set(i, ray.direction);
     radiance.set(i, Rgb(0.0f));
+    emitted.set(i, Rgb(0.0f));
+    emittedOpen[i] = -1;
     beta.set(i, Rgb(1.0f));
     previousPdf[i] = 0;
     pathLength[i] = 0;
@@ -118,6 +122,7 @@ struct Paths {
   PathSample sample(int i) const {
     PathSample s;
     s.L = radiance.rgbAt(i);
+    s.emitted = emitted.rgbAt(i);
     s.albedo = albedo.rgbAt(i);
     s.normal = normal.at(i);
     s.depth = featureDepth[i];
@@ -217,7 +222,7 @@ class LaneTileRenderer {
     l.y = tile_.y0 + nextPixel_ / width;
     ++nextPixel_;
     l.sample = 0;
-    l.pixel = PixelAccumulator{};
+    l.pixel = PixelAccumulator(film_.separatesEmission());
     alive_[i] = -1;
     startSample(i);
   }
@@ -270,7 +275,9 @@ class LaneTileRenderer {
     if (!arrival.Le.isBlack()) {
       const float w =
           previousDelta ? 1.0f : powerHeuristic(p_.previousPdf[i], arrival.pdfSolidAngle);
-      p_.radiance.set(i, p_.radiance.rgbAt(i) + p_.beta.rgbAt(i) * arrival.Le * w);
+      const Rgb contribution = p_.beta.rgbAt(i) * arrival.Le * w;
+      p_.radiance.set(i, p_.radiance.rgbAt(i) + contribution);
+      if (p_.emittedOpen[i]) p_.emitted.set(i, p_.emitted.rgbAt(i) + contribution);
     }
     if (!p_.locked[i]) {
       p_.albedo.set(i, p_.beta.rgbAt(i));
@@ -377,8 +384,12 @@ class LaneTileRenderer {
         weight = powerHeuristic(p_.previousPdf[i],
                                 t_.lights_->pdfAreaLight(p_.previousPosition.at(i), lightPoint));
       }
-      p_.radiance.set(i, p_.radiance.rgbAt(i) + p_.beta.rgbAt(i) * emission.rgbAt(i) * weight);
+      const Rgb contribution = p_.beta.rgbAt(i) * emission.rgbAt(i) * weight;
+      p_.radiance.set(i, p_.radiance.rgbAt(i) + contribution);
+      if (p_.emittedOpen[i]) p_.emitted.set(i, p_.emitted.rgbAt(i) + contribution);
     }
+
+    p_.emittedOpen &= ~(v.hit & (v.transmissive | ~v.specular));
 
     // The shading frame: opaque surfaces are shaded from the side the ray arrives on,
     // transmissive ones keep their outward frame.

@@ -27,7 +27,12 @@ struct FeatureRecorder {
 }  // namespace
 
 Ray startPixelSample(Sampler& sampler, const Camera& camera, int x, int y, int sample, int splits) {
-  sampler.startPixelSample(x, y, uint32_t(sample / splits), sample % splits);
+  return startCameraSample(sampler, camera, x, y, uint32_t(sample / splits), sample % splits);
+}
+
+Ray startCameraSample(Sampler& sampler, const Camera& camera, int x, int y, uint32_t index,
+                      int stream) {
+  sampler.startPixelSample(x, y, index, stream);
   const Vec2f offset = sampler.getPixel2D();
   // The lens sample follows the film position; pinhole renders draw none, so their dimensions
   // (and images) are what they were before cameras had lenses.
@@ -57,10 +62,23 @@ bool PathTracer::unoccluded(const SurfaceInteraction& si, const Vec3f& ng,
 }
 
 PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& rays) const {
+  return trace(cameraRay, sampler, rays, false);
+}
+
+Rgb PathTracer::traceEmission(const Ray& cameraRay, Sampler& sampler, RayCounts& rays) const {
+  return trace(cameraRay, sampler, rays, true).emitted;
+}
+
+PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& rays,
+                             bool emissionOnly) const {
   PathSample out;
   FeatureRecorder features;
   float visibility = 0;
-  Rgb L(0.0f), beta(1.0f);
+  Rgb L(0.0f), beta(1.0f), emitted(0.0f);
+  // Whether emission reached now is `emitted`: until the first vertex that is not purely
+  // specular, or one of glass (it reflects or transmits at random, so what it shows varies
+  // from sample to sample and is left to the denoisers).
+  bool emittedOpen = true;
   float etaScale = 1.0f;  // radiance scaling by refraction, removed for roulette decisions
   Ray ray = cameraRay;
   bool previousDelta = true;  // the camera ray counts as a delta event: no MIS on its hit
@@ -83,7 +101,9 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
           lights_.environmentArrival(direction, !previousDelta);
       if (!arrival.Le.isBlack()) {
         const float w = previousDelta ? 1.0f : powerHeuristic(previousPdf, arrival.pdfSolidAngle);
-        L += beta * arrival.Le * w;
+        const Rgb contribution = beta * arrival.Le * w;
+        L += contribution;
+        if (emittedOpen) emitted += contribution;
       }
       if (!features.locked) {
         features.record(beta, Vec3f{}, 0.0f);
@@ -106,13 +126,16 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
       const float w = previousDelta
                           ? 1.0f
                           : powerHeuristic(previousPdf, lights_.pdfAreaLight(previousPosition, si));
-      L += beta * Le * w;
+      const Rgb contribution = beta * Le * w;
+      L += contribution;
+      if (emittedOpen) emitted += contribution;
     }
 
     const Bsdf& bsdf = material.uniformBsdf ? *material.uniformBsdf
                                             : texturedBsdf.emplace(scene_.materialPoint(si));
     const bool transmissive = bsdf.hasTransmission();
     const bool specular = bsdf.isPurelySpecular();
+    if (transmissive || !specular) emittedOpen = false;
     const Vec3f wo = -normalize(ray.direction);
     // Opaque surfaces are shaded from the side the ray arrives on (both sides reflect);
     // transmissive ones keep their outward frame so that wo.z < 0 means "from inside".
@@ -132,7 +155,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
 
     if (!features.locked)
       features.record(beta * bsdf.albedo(), faceForward(frame.z, wo), pathLength);
-    if (depth >= settings_.maxDepth) break;
+    if (depth >= settings_.maxDepth || (emissionOnly && !emittedOpen)) break;
     const Sampler::BounceDraws u = sampler.getBounce(bounceDimensions);
     const Bsdf::Outgoing outgoing = bsdf.prepare(woLocal);
 
@@ -191,6 +214,7 @@ PathSample PathTracer::trace(const Ray& cameraRay, Sampler& sampler, RayCounts& 
   }
 
   out.L = L;
+  out.emitted = emitted;
   out.albedo = features.albedo;
   out.normal = features.normal;
   out.depth = features.depth;

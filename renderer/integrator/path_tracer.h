@@ -13,6 +13,11 @@
 //   depth       distance travelled along the path from the camera to the vertex
 //   visibility  1 if the vertex's next-event estimate found its light unoccluded with a non-zero
 //               contribution, else 0 (the pixel mean is the fraction of unoccluded shadow rays)
+//   emitted     (not a feature) the part of the radiance emitted by what the camera sees
+//               directly or through mirrors: lights and the environment reached before that
+//               vertex or a glass one, and the own emission of the first such vertex
+//               (renderer/render.h's separateEmission takes it out of the colour the
+//               denoisers filter)
 // Rays that escape before such a vertex: albedo = the chain's throughput (1 for camera rays:
 // white, so dividing by albedo leaves the background unchanged), normal = 0, depth = 0,
 // visibility = 1. Paths that end inside a specular chain (absorbed, roulette, maximum depth)
@@ -38,6 +43,10 @@ struct PathTracerSettings {
 // Starts sample `sample` of pixel (x, y) — sub-buffer sample mod splits, index sample / splits
 // in it — and returns its camera ray through the position in the pixel drawn first.
 Ray startPixelSample(Sampler& sampler, const Camera& camera, int x, int y, int sample, int splits);
+// The same for sample `index` of the sampler's stream `stream` (a sub-buffer, or another
+// independent set of draws such as the emission pass's).
+Ray startCameraSample(Sampler& sampler, const Camera& camera, int x, int y, uint32_t index,
+                      int stream);
 
 // Beer–Lambert transmittance through `distance` of a KHR_materials_volume interior:
 // σ = −ln(attenuationColor) / attenuationDistance.
@@ -57,8 +66,13 @@ class PathTracer {
   // One path from a camera ray. Consumes sampler dimensions in the order documented in
   // renderer/sampling/sampler.h; adds the rays it traces to `rays`.
   PathSample trace(const Ray& cameraRay, Sampler& sampler, RayCounts& rays) const;
+  // PathSample::emitted of a path from this camera ray, traced only as far as that needs (the
+  // first vertex that is not purely specular; no light samples), with the same draws.
+  Rgb traceEmission(const Ray& cameraRay, Sampler& sampler, RayCounts& rays) const;
 
  private:
+  PathSample trace(const Ray& cameraRay, Sampler& sampler, RayCounts& rays,
+                   bool emissionOnly) const;
   bool unoccluded(const SurfaceInteraction& si, const Vec3f& ng, const LightSample& light) const;
 
   const Scene& scene_;

@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -94,6 +95,11 @@ std::optional<fs::path> sharedDir() {
   return std::nullopt;
 }
 
+bool sameImage(const Image& a, const Image& b) {
+  return a.sameShape(b) &&
+         std::equal(a.values().begin(), a.values().end(), b.values().begin(), b.values().end());
+}
+
 Image randomImage(int width, int height, int channels, uint32_t seed, float lo, float hi) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> dist(lo, hi);
@@ -102,7 +108,9 @@ Image randomImage(int width, int height, int channels, uint32_t seed, float lo, 
   return image;
 }
 
-std::string cornellBox() { return (sourceDir() / "scenes" / "cornell-box.gltf").string(); }
+std::string cornellBox() {
+  return (sourceDir() / "scenes" / "cornell-box.gltf").string();
+}
 
 nlohmann::json readJson(const std::filesystem::path& file) {
   std::ifstream in(file);

@@ -62,4 +62,7 @@ std::optional<std::filesystem::path> sharedDir();
 Image randomImage(int width, int height, int channels, uint32_t seed, float lo = 0.0f,
                   float hi = 1.0f);
 
+// The same size, channels and values bit for bit (two empty images are the same).
+bool sameImage(const Image& a, const Image& b);
+
 }  // namespace chorus::test

@@ -1,17 +1,12 @@
 #include "tests/support/tracer_comparison.h"
 
+#include "tests/support/test_support.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
 namespace chorus::test {
-namespace {
-
-bool sameImage(const Image& a, const Image& b) {
-  return std::equal(a.values().begin(), a.values().end(), b.values().begin(), b.values().end());
-}
-
-}  // namespace
 
 double expectTracersAgree(const render::Scene& scene, render::RenderOptions options) {
   options.tracer = render::RenderOptions::Tracer::OnePath;
@@ -28,6 +23,9 @@ double expectTracersAgree(const render::Scene& scene, render::RenderOptions opti
       EXPECT_TRUE(sameImage(a.varianceOfMean, b.varianceOfMean))
           << quantityName(q) << " variance, sub-buffer " << k;
     }
+  EXPECT_TRUE(sameImage(onePath.buffers.emission(), lanes.buffers.emission())) << "emission";
+  EXPECT_EQ(onePath.buffers.emission().empty(), !options.separateEmission);
+  EXPECT_EQ(onePath.stats.emissionPixels, lanes.stats.emissionPixels);
   EXPECT_EQ(onePath.stats.rays, lanes.stats.rays);
   EXPECT_EQ(onePath.stats.shadowRays, lanes.stats.shadowRays);
   EXPECT_EQ(onePath.stats.nanSamplesDropped, lanes.stats.nanSamplesDropped);

@@ -63,6 +63,7 @@ int main(int argc, char** argv) {
   std::string scenePath = "scenes/cornell-box.gltf", preview = cli::kPreviewDenoise,
               full = cli::kDefaultDenoise, cache;
   int size = 512, spp = 4, threads = 2, repeat = 5, referenceSpp = 1024;
+  int emissionSamples = render::RenderOptions{}.emissionSamples;
   app.add_option("--scene", scenePath, "glTF scene")->capture_default_str();
   app.add_option("--size", size, "Image width and height")->capture_default_str();
   app.add_option("--spp", spp, "Samples per pixel")->capture_default_str();
@@ -75,6 +76,9 @@ int main(int argc, char** argv) {
   app.add_option("--reference-spp", referenceSpp, "Reference samples per pixel")
       ->capture_default_str();
   app.add_option("--reference-cache", cache, "Directory to keep the reference render in");
+  app.add_option("--emission-samples", emissionSamples,
+                 "As chorus render's flag: emission-pass rays per pixel (0: not separated)")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   tbb::global_control control(tbb::global_control::max_allowed_parallelism, size_t(threads));
 
@@ -86,6 +90,8 @@ int main(int argc, char** argv) {
   options.width = options.height = size;
   options.spp = spp;
   options.threads = threads;
+  options.separateEmission = emissionSamples > 0;
+  options.emissionSamples = std::max(emissionSamples, 1);
   CombineOptions previewOptions;
   cli::applyPreviewDefaults(previewOptions);  // as `chorus render --preview`
   const Ensemble ensemble(membersFromSpecs(splitMethodList(preview)), previewOptions);

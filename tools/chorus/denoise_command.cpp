@@ -173,8 +173,10 @@ MemberRuns runAlone(ReadInput& input, const std::vector<std::string>& specs,
     throw fileError(input.path, e.what() + inputHint(input, true));
   }
   std::vector<Image> images = runMembersAlone(full, members, &runs.times, progress);
-  for (size_t m = 0; m < members.size(); ++m)
+  for (size_t m = 0; m < members.size(); ++m) {
+    if (input.render) addEmission(images[m], input.render->emission());
     runs.bases.push_back({members[m].label, {}, {}, std::move(images[m]), {}});
+  }
   return runs;
 }
 
@@ -212,7 +214,7 @@ MemberRuns runForEnsemble(ReadInput& input, const std::vector<std::string>& spec
 Image noisyColor(const ReadInput& input) {
   if (input.outputs) return input.outputs->guides.color;
   if (input.tungsten) return input.tungsten->whole.color.mean;
-  return input.render->part(BufferPart::Full).color.mean;
+  return input.render->noisyColor();
 }
 
 // The combiners of --combine; none of them for --combine none (or no --combine and one method).

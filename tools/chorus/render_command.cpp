@@ -128,6 +128,13 @@ nlohmann::ordered_json statsJson(const RenderArgs& args, const RenderOptions& op
   j["triangles"] = s.triangles;
   j["nan_samples_dropped"] = s.nanSamplesDropped;
   j["tracer"] = s.lanes ? "lanes" : "one-path";
+  // What the emission pass re-estimated (0 pixels: the samples of every pixel agreed).
+  if (options.separateEmission)
+    j["emission"] = {{"samples", options.emissionSamples},
+                     {"pixels", s.emissionPixels},
+                     {"seconds", s.emissionSeconds}};
+  else
+    j["emission"] = "denoised with the rest";
   j["warnings"] = loaded.warnings;
   j["chorus_version"] = CHORUS_VERSION;
   return j;
@@ -226,7 +233,7 @@ void runRender(RenderArgs args) {
     writeExr(out.path() / "render.exr", layers, ExrPixelType::Float);
     writePng(out.path() / "color.png", layers.front().image);  // the full-buffer colour mean
   } else if (!sources) {
-    writePng(out.path() / "color.png", result.buffers.part(BufferPart::Full).color.mean);
+    writePng(out.path() / "color.png", result.buffers.noisyColor());
   }
   stats["seconds"]["write render"] = write.seconds();
   result.buffers = {};

@@ -20,6 +20,8 @@ namespace {
 constexpr int64_t kMaxCameraIndex = 1'000'000;
 // Lens radii and focus distances: far beyond any scene's size (float keeps ~7 digits there).
 constexpr double kMaxSceneLength = 1e12;
+// Emission-pass rays per pixel: far beyond what resolves an edge.
+constexpr int64_t kMaxEmissionSamples = 65536;
 
 // --background: parseRgb's R,G,B (or grey) with non-negative components, each at most
 // kMaxRadianceScale.
@@ -82,6 +84,18 @@ void SceneOptions::addFlags(CLI::App& cmd) {
                  "the surface under the image centre)")
       ->capture_default_str()
       ->transform(finiteIn(0, kMaxSceneLength));
+  cmd.add_option_function<int>(
+         "--emission-samples",
+         [this](int samples) {
+           render.separateEmission = samples > 0;
+           if (samples > 0) render.emissionSamples = samples;
+         },
+         "Emission seen directly or through mirrors and glass is kept out of the denoisers' "
+         "input and added back to every image, estimated from this many camera rays per pixel "
+         "where the pixel's samples disagree on it (light edges, defocused lights); 0: denoise "
+         "it with the rest")
+      ->transform(integerIn(0, kMaxEmissionSamples))
+      ->default_str(std::to_string(render.emissionSamples));
   auto* backgroundFlag = cmd.add_option("--background", background,
                                         "Constant environment radiance R,G,B (or one grey value)")
                              ->transform(radianceColour());

@@ -12,12 +12,18 @@
 namespace chorus::cli {
 
 struct SceneOptions {
-  render::RenderOptions render;  // spp and splits are the caller's
+  // spp and splits are the caller's. The commands separate emission unless told not to
+  // (--emission-samples 0).
+  render::RenderOptions render = [] {
+    render::RenderOptions o;
+    o.separateEmission = true;
+    return o;
+  }();
   std::string background, env;
   float envRotate = 0, envIntensity = 1;
 
   // Adds --width --height --seed --threads --max-depth --camera --lens-radius --focus-distance
-  // --background --env --env-rotate --env-intensity to `cmd`.
+  // --emission-samples --background --env --env-rotate --env-intensity to `cmd`.
   void addFlags(CLI::App& cmd);
   render::EnvironmentDesc environment() const;
   // "default white (no lights in scene)", the --env file, "constant R,G,B" or "none".

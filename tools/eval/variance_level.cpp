@@ -55,7 +55,7 @@ void run(const std::string& renderPath, const std::string& referencePath, int ra
   if (!reference.sameShape(full.whole.color.mean))
     throw Error(referencePath + ": its size differs from the render's");
   const Image& recordedVariance = full.whole.color.varianceOfMean;
-  const double error = relMse(full.whole.color.mean, reference);
+  const double error = relMse(buffers.noisyColor(), reference);
   const double recorded = relativeMean(recordedVariance, reference);
   const double spread = relativeMean(subBufferSpread(buffers), reference);
   const double calibrated = relativeMean(calibratedWholeColorVariance(full, radius), reference);

@@ -227,6 +227,9 @@ std::string checkSampleBuffers(const SampleBuffers& buffers) {
     for (const float n : sub.sampleCount.values())
       if (!(n >= 0) || !std::isfinite(n)) return "sample count " + std::to_string(n) + " accepted";
   }
+  // Added to every output image: finite and non-negative, or rejected.
+  for (const float e : buffers.emission().values())
+    if (!(e >= 0) || !std::isfinite(e)) return "emission " + std::to_string(e) + " accepted";
   return "";
 }
 

@@ -18,7 +18,7 @@ Image referenceRender(const render::Scene& scene, render::RenderOptions options,
     if (options.width <= 0 || cached.width() == options.width) return cached;
   }
   const Stopwatch time;
-  Image reference = render::render(scene, options).buffers.part(BufferPart::Full).color.mean;
+  Image reference = render::render(scene, options).buffers.noisyColor();
   if (!log.empty())
     std::fprintf(stderr, "%s: reference %dx%d at %d spp in %.1f s\n", log.c_str(),
                  reference.width(), reference.height(), options.spp, time.seconds());

@@ -44,14 +44,14 @@ struct RenderOptions {
   // The planes the sub-buffers record (colour always): what the denoisers will read. The planes
   // kept are bit-identical whatever the others are.
   BufferPlanes planes = BufferPlanes::all();
-  // Emission seen directly or through mirrors and glass (PathSample::emitted) is taken out of
-  // every sample's colour and kept in SampleBuffers::emission(): the denoisers then filter only
-  // the light reflected by what the camera sees, and a small lamp's radiance cannot spread over
-  // its neighbours. Where a pixel's samples saw different emission (the edge of a light, a
-  // defocused light, glass that reflects or transmits at random), and next to such pixels, that
-  // plane is estimated again from emissionSamples camera paths followed only as far as their
-  // first surface that is not a mirror or glass (emission_pass.h): edges of lights are then
-  // resolved as well as at that many samples per pixel, at the cost of a camera ray each.
+  // Emission seen directly or in mirrors (PathSample::emitted; not through glass) is taken out
+  // of every sample's colour and kept in SampleBuffers::emission(): the denoisers then filter
+  // only the light reflected by what the camera sees, and a small lamp's radiance cannot spread
+  // over its neighbours. Where a pixel's samples saw different emission (the edge of a light, a
+  // defocused light, a sky's texture), and next to such pixels, that plane is estimated again
+  // from emissionSamples more camera paths followed only as far as their first surface that is
+  // not a mirror (emission_pass.h): edges of lights are then resolved as well as at that many
+  // samples per pixel, at the cost of a camera ray each.
   bool separateEmission = false;
   int emissionSamples = 64;
 };

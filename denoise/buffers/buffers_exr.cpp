@@ -91,7 +91,8 @@ SubBuffer readSubBuffer(const std::vector<ExrLayer>& layers, const std::string& 
 
 namespace {
 
-// Both overloads: Buffers is SampleBuffers (copied from) or SampleBuffers& (moved from).
+// Both overloads: Buffers is const SampleBuffers (copied from) or SampleBuffers (its
+// sub-buffers moved from).
 template <typename Buffers>
 std::vector<ExrLayer> toLayers(Buffers& buffers) {
   std::vector<ExrLayer> layers;

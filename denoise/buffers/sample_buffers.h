@@ -138,7 +138,7 @@ class SampleBuffers {
   // quarters 2/3, full gets A/B. With K = 2 only the full buffer has halves; with K = 1 none.
   DenoiseInput input(BufferPart which) const;
 
-  // The emission the camera sees directly or through mirrors and glass (RGB), when the render
+  // The emission the camera sees directly or in mirrors (RGB), when the render
   // took it out of every sub-buffer's colour (renderer/render.h, separateEmission); else empty.
   // The sub-buffers' colour is then what is left to denoise, and every image of the scene is
   // that colour (or a denoised version of it) plus this plane: see noisyColor.

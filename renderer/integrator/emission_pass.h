@@ -1,11 +1,11 @@
 #pragma once
 // The emission pass of a render that separates emission (RenderOptions::separateEmission): the
-// film's emission plane holds, per pixel, what its samples saw emitted directly or through
-// mirrors and glass when they all saw the same, which is then exact. Where they differ (the edge
-// of a light, a defocused light, glass that reflects or transmits at random), and next to such
-// pixels (an edge that the few samples all missed), the plane is estimated again from many
-// camera paths of their own that stop at the first surface that is not purely specular: a
-// camera ray and the specular chain each, no light samples, so it costs little beside the paths.
+// film's emission plane holds, per pixel, the mean of what its samples saw emitted directly or in
+// mirrors, which is exact when they all saw the same. Where they differ (the edge of a light, a
+// defocused light, a sky's texture), and next to such pixels (an edge that the few samples all
+// missed), it is estimated again with many camera paths of its own that stop at the first
+// surface that is not a mirror: a camera ray and the mirror bounces each, no light samples, so
+// it costs little beside the paths.
 #include <cstdint>
 #include <vector>
 

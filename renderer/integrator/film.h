@@ -18,7 +18,7 @@ struct PathSample {
   Vec3f normal;
   float depth = 0;
   float visibility = 0;
-  Rgb emitted;  // the part of L seen directly or through specular chains (path_tracer.h)
+  Rgb emitted;  // the part of L seen directly or in mirrors (path_tracer.h)
 
   bool isFinite() const;
 };

@@ -90,7 +90,7 @@ void SceneOptions::addFlags(CLI::App& cmd) {
            render.separateEmission = samples > 0;
            if (samples > 0) render.emissionSamples = samples;
          },
-         "Emission seen directly or through mirrors and glass is kept out of the denoisers' "
+         "Emission seen directly or in mirrors (not through glass) is kept out of the denoisers' "
          "input and added back to every image, estimated from this many camera rays per pixel "
          "where the pixel's samples disagree on it (light edges, defocused lights); 0: denoise "
          "it with the rest")

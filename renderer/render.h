@@ -54,6 +54,11 @@ struct RenderOptions {
   // samples per pixel, at the cost of a camera ray each.
   bool separateEmission = false;
   int emissionSamples = 64;
+  // What `--emission-samples N` means: separated with N pass samples, or not at all for N = 0.
+  void setEmissionSamples(int samples) {
+    separateEmission = samples > 0;
+    if (samples > 0) emissionSamples = samples;
+  }
 };
 
 struct RenderStats {

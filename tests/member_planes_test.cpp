@@ -12,6 +12,7 @@
 #include "denoise/pipeline/ensemble.h"
 #include "denoise/pipeline/member_planes.h"
 #include "tests/support/synthetic_scene.h"
+#include "tests/support/test_support.h"
 
 namespace chorus {
 namespace {
@@ -53,10 +54,6 @@ SampleBuffers stripped(const SampleBuffers& buffers, BufferPlanes planes) {
   return SampleBuffers(std::move(subs));
 }
 
-bool sameBits(const Image& a, const Image& b) {
-  return a.sameSize(b) && std::equal(a.values().begin(), a.values().end(), b.values().begin());
-}
-
 TEST(MemberPlanes, EveryMemberReadsExactlyThePlanesItsEntryLists) {
   const SampleBuffers buffers = sceneBuffers();
   ASSERT_EQ(buffers.sub(0).planes(), BufferPlanes::all());
@@ -71,14 +68,14 @@ TEST(MemberPlanes, EveryMemberReadsExactlyThePlanesItsEntryLists) {
         const std::string plane = entry.name + ": " + std::string(quantityName(q)) +
                                   (p == Plane::Mean ? "" : " variance");
         if (read.has(q, p))
-          EXPECT_FALSE(sameBits(reference, other)) << plane << " is listed but not read";
+          EXPECT_FALSE(test::sameImage(reference, other)) << plane << " is listed but not read";
         else
-          EXPECT_TRUE(sameBits(reference, other)) << plane << " is read but not listed";
+          EXPECT_TRUE(test::sameImage(reference, other)) << plane << " is read but not listed";
       }
     }
     // Without the planes it does not read (empty images), the same bits.
     const Image alone = member->run(stripped(buffers, read).input(BufferPart::Full));
-    EXPECT_TRUE(sameBits(reference, alone)) << entry.name;
+    EXPECT_TRUE(test::sameImage(reference, alone)) << entry.name;
   }
 }
 
@@ -98,9 +95,9 @@ TEST(MemberPlanes, TheEnsembleOnBuffersHoldingWhatItReadsGivesTheSameBits) {
   const Ensemble ensemble(members, {});
   const EnsembleResult all = ensemble.run(buffers);
   const EnsembleResult some = ensemble.run(stripped(buffers, needed));
-  EXPECT_TRUE(sameBits(all.combined.image, some.combined.image));
+  EXPECT_TRUE(test::sameImage(all.combined.image, some.combined.image));
   for (size_t m = 0; m < members.size(); ++m)
-    EXPECT_TRUE(sameBits(all.bases[m].full, some.bases[m].full)) << specs[m];
+    EXPECT_TRUE(test::sameImage(all.bases[m].full, some.bases[m].full)) << specs[m];
 }
 
 TEST(MemberPlanes, MissingPlanesAreOneLineNamingTheMemberAndThePlanes) {

@@ -57,6 +57,15 @@ const Image& requirePlane(const std::vector<ExrLayer>& layers, const std::string
   return *image;
 }
 
+// Throws naming `file` and `layer` unless every value of `image` is finite and ≥ 0: a negative
+// or non-finite one (a corrupt or hand-edited file) is not `what`.
+void requireNonNegative(const Image& image, const std::string& layer,
+                        const std::filesystem::path& file, const std::string& what) {
+  for (const float v : image.values())
+    if (!(v >= 0.0f) || !std::isfinite(v))
+      throw fileError(file, "layer '" + layer + "' holds " + std::to_string(v) + ", not " + what);
+}
+
 SubBuffer readSubBuffer(const std::vector<ExrLayer>& layers, const std::string& prefix,
                         const std::filesystem::path& file) {
   SubBuffer sub;
@@ -78,12 +87,9 @@ SubBuffer readSubBuffer(const std::vector<ExrLayer>& layers, const std::string& 
     }
   }
   sub.sampleCount = requirePlane(layers, prefix + "sampleCount", 1, file);
-  // Counts weigh the sub-buffers when they are merged: a negative or non-finite one (a corrupt
-  // or hand-edited file) would turn every merged mean into nonsense.
-  for (const float n : sub.sampleCount.values())
-    if (!(n >= 0.0f) || !std::isfinite(n))
-      throw fileError(file, "layer '" + prefix + "sampleCount' holds " + std::to_string(n) +
-                                ", not a sample count");
+  // Counts weigh the sub-buffers when they are merged: a bad one would turn every merged mean
+  // into nonsense.
+  requireNonNegative(sub.sampleCount, prefix + "sampleCount", file, "a sample count");
   return sub;
 }
 
@@ -138,9 +144,8 @@ SampleBuffers sampleBuffersFromLayers(const std::vector<ExrLayer>& layers,
   if (const Image* emission = findPlane(layers, "emission", 3, fileForErrors)) {
     if (emission->width() != buffers.width() || emission->height() != buffers.height())
       throw fileError(fileForErrors, "layer 'emission' differs in size from the sub-buffers");
-    for (size_t i = 0; i < emission->size(); ++i)
-      if (!(emission->data()[i] >= 0) || !std::isfinite(emission->data()[i]))
-        throw fileError(fileForErrors, "layer 'emission' holds a negative or non-finite value");
+    // Added to every output image: a bad value would reach all of them.
+    requireNonNegative(*emission, "emission", fileForErrors, "an emitted radiance");
     buffers.setEmission(*emission);
   }
   return buffers;

@@ -12,8 +12,8 @@
 //                                        buffer is the exact merge of the sub-buffers and is not
 //                                        stored
 //   emission                             when the render separated it (SampleBuffers::emission):
-//                                        what the camera sees emitted directly or through mirrors
-//                                        and glass (RGB), left out of every sub<k>.color
+//                                        what the camera sees emitted directly or in mirrors
+//                                        (RGB), left out of every sub<k>.color
 //
 // With K = 1 and no emission the one buffer's layers carry no prefix: "" is its colour mean,
 // then colorVariance, albedo, … as above (with emission it is sub0, so that "" is the image).

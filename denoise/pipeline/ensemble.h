@@ -106,9 +106,9 @@ inline constexpr long kWideWindowPixels = 131072;  // 2^17, e.g. 512 x 256
 CombineOptions optionsForRuns(CombineOptions options, const BaseRuns& runs,
                               std::span<const EnsembleMember> members, int width, int height);
 // Every member on the runs that `runs` asks for, in parallel, each output with the sources'
-// emission added back. Appends "<label>/A",
-// "<label>/B", "<label>/full", "<label>/without-q<k>" (the time of each run) and "bases" (wall
-// time of all of them) to `times`; reports each run's end to `progress`.
+// emission added back. Appends "<label>/A", "<label>/B", "<label>/full", "<label>/without-q<k>"
+// (the time of each run) and "bases" (wall time of all of them) to `times`; reports each run's
+// end to `progress`.
 std::vector<BaseOutputs> runBaseDenoisers(const EnsembleSources& sources,
                                           std::span<const EnsembleMember> members,
                                           std::vector<StageTime>* times = nullptr,

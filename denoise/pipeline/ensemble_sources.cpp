@@ -80,9 +80,8 @@ EnsembleGuides guidesFromSources(const EnsembleSources& sources, bool withQuarte
   if (withQuarters && sources.a.halves && sources.b.halves)
     for (const DenoiseInput* half : {&sources.a, &sources.b})
       for (const SubBuffer& quarter : *half->halves) guides.quarters.push_back(quarter.color.mean);
-  addEmission(guides.color, sources.emission);
-  addEmission(guides.colorA, sources.emission);
-  addEmission(guides.colorB, sources.emission);
+  for (Image* noisy : {&guides.color, &guides.colorA, &guides.colorB})
+    addEmission(*noisy, sources.emission);
   for (Image& quarter : guides.quarters) addEmission(quarter, sources.emission);
   guides.albedo = sources.full.whole.albedo.mean;
   guides.normal = sources.full.whole.normal.mean;

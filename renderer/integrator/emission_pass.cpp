@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 
@@ -12,21 +13,17 @@ namespace chorus::render {
 
 std::vector<uint32_t> emissionPassPixels(const Film& film) {
   const int width = film.width(), height = film.height();
-  std::vector<uint32_t> pixels;
-  for (int y = 0; y < height; ++y) {
+  std::vector<uint8_t> near(size_t(width) * size_t(height), 0);
+  for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
-      bool near = false;
-      for (int dy = -1; dy <= 1 && !near; ++dy) {
-        const int yy = y + dy;
-        if (yy < 0 || yy >= height) continue;
-        for (int dx = -1; dx <= 1 && !near; ++dx) {
-          const int xx = x + dx;
-          near = xx >= 0 && xx < width && film.emittedVaries(xx, yy);
-        }
-      }
-      if (near) pixels.push_back(uint32_t(y) * uint32_t(width) + uint32_t(x));
+      if (!film.emittedVaries(x, y)) continue;
+      for (int yy = std::max(0, y - 1); yy <= std::min(height - 1, y + 1); ++yy)
+        for (int xx = std::max(0, x - 1); xx <= std::min(width - 1, x + 1); ++xx)
+          near[size_t(yy) * size_t(width) + size_t(xx)] = 1;
     }
-  }
+  std::vector<uint32_t> pixels;
+  for (size_t i = 0; i < near.size(); ++i)
+    if (near[i]) pixels.push_back(uint32_t(i));
   return pixels;
 }
 

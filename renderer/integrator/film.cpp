@@ -19,29 +19,28 @@ std::array<float, kPathSampleChannels> channels(const PathSample& s) {
 
 bool PathSample::isFinite() const {
   // A sum of floats taken in double cannot overflow, so it is finite exactly when every term is
-  // (one test instead of fourteen).
-  double sum = double(emitted.r) + double(emitted.g) + double(emitted.b);
+  // (one test instead of eleven). `emitted` needs none: it is the first of the non-negative
+  // terms L sums, so it is finite when L is.
+  double sum = 0;
   for (float v : channels(*this)) sum += double(v);
   return std::isfinite(sum);
 }
 
 bool PixelAccumulator::add(int k, const PathSample& sample) {
   if (!sample.isFinite()) return false;
-  if (kept_++ == 0) firstEmitted_ = sample.emitted;
-  for (int c = 0; c < 3; ++c) {
-    const float e = sample.emitted[c], first = firstEmitted_[c];
-    if (e != first) emittedVaries_ = true;
-    emittedSum_[size_t(c)] += double(e);
+  auto values = channels(sample);
+  if (separateEmission_) {  // nothing of this on the hot path of a render that keeps emission in
+    if (kept_++ == 0) firstEmitted_ = sample.emitted;
+    for (int c = 0; c < 3; ++c) {
+      const float e = sample.emitted[c];
+      if (e != firstEmitted_[c]) emittedVaries_ = true;
+      emittedSum_[size_t(c)] += double(e);
+      values[size_t(c)] -= e;
+    }
   }
   Stats& s = stats_[size_t(k)];
   ++s.count;
   const double rcpCount = 1.0 / double(s.count);  // one division for all channels
-  auto values = channels(sample);
-  if (separateEmission_) {
-    values[0] -= sample.emitted.r;
-    values[1] -= sample.emitted.g;
-    values[2] -= sample.emitted.b;
-  }
   for (size_t c = 0; c < values.size(); ++c) {
     // Welford: mean_n = mean_{n−1} + δ/n, M2_n = M2_{n−1} + δ (x − mean_n).
     const double x = values[c];

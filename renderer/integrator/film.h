@@ -36,10 +36,10 @@ class PixelAccumulator {
   // Adds a sample to sub-buffer k; returns false (and keeps nothing) when it is not finite.
   bool add(int k, const PathSample& sample);
 
-  // The mean `emitted` part of the samples kept (0 without one), and whether some sample's
-  // differs from the first's: where none does, it is the pixel's emission. (A tolerance of 2 %
-  // saved a third of the emission pass on sky scenes but multiplied by 2 to 19 the pass's
-  // error there: docs/emission.md.)
+  // With separateEmission (else 0 and false): the mean `emitted` part of the samples kept (0
+  // without one), and whether some sample's differs from the first's: where none does, it is
+  // the pixel's emission. (A tolerance of 2 % saved a third of the emission pass on sky scenes
+  // but multiplied by 2 to 19 the pass's error there: docs/emission.md.)
   Rgb emitted() const;
   bool emittedVaries() const { return emittedVaries_; }
 

@@ -90,8 +90,7 @@ int main(int argc, char** argv) {
   options.width = options.height = size;
   options.spp = spp;
   options.threads = threads;
-  options.separateEmission = emissionSamples > 0;
-  options.emissionSamples = std::max(emissionSamples, 1);
+  options.setEmissionSamples(emissionSamples);
   CombineOptions previewOptions;
   cli::applyPreviewDefaults(previewOptions);  // as `chorus render --preview`
   const Ensemble ensemble(membersFromSpecs(splitMethodList(preview)), previewOptions);

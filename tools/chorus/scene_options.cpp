@@ -85,11 +85,7 @@ void SceneOptions::addFlags(CLI::App& cmd) {
       ->capture_default_str()
       ->transform(finiteIn(0, kMaxSceneLength));
   cmd.add_option_function<int>(
-         "--emission-samples",
-         [this](int samples) {
-           render.separateEmission = samples > 0;
-           if (samples > 0) render.emissionSamples = samples;
-         },
+         "--emission-samples", [this](int samples) { render.setEmissionSamples(samples); },
          "Emission seen directly or in mirrors (not through glass) is kept out of the denoisers' "
          "input and added back to every image, estimated from this many camera rays per pixel "
          "where the pixel's samples disagree on it (light edges, defocused lights); 0: denoise "

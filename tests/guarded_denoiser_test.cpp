@@ -150,6 +150,80 @@ TEST(KeepWithinTheSamples, BoundsOnlyWellMeasuredPixels) {
   EXPECT_NEAR(out(3, 0, 1), 2.0f, 1e-6);  // the other channels have their variance
 }
 
+// 7x7 pixels at 0.1 with standard error 0.1 and 16 samples (a dim surface lit by rare bright
+// paths); the centre's samples all missed them: 0.02 with standard error 0.001.
+SubBuffer anUnluckyPixel() {
+  SubBuffer whole = constantBuffer(7, 7, 0.1f);
+  whole.sampleCount.fill(16);
+  for (int c = 0; c < 3; ++c) {
+    whole.color.mean(3, 3, c) = 0.02f;
+    whole.color.varianceOfMean(3, 3, c) = 1e-6f;
+  }
+  return whole;
+}
+
+TEST(KeepWithinTheSamples, AnUnluckyPixelMayRiseToItsNeighbours) {
+  // Its neighbours' variance is that of a path found by p = 0.09 / (0.09 + 16 * 0.09) = 1/17 of
+  // the samples (channels summed), which all 16 miss with probability (16/17)^16 = 0.38. Its
+  // own samples would hold a member's 2 down to 0.02 + 10 * 0.001; bounded by its
+  // neighbourhood's standard error (0.02 + 10 * 0.1) but no higher than its typical neighbour,
+  // it gets 0.1. The other pixels keep their own bound, 0.1 + 10 * 0.1.
+  SubBuffer whole = anUnluckyPixel();
+  Image out(7, 7, 3);
+  out.fill(2.0f);
+  keepWithinTheSamples(out, whole, 10.0);
+  EXPECT_NEAR(out(3, 3, 0), 0.1f, 1e-6);
+  EXPECT_NEAR(out(2, 3, 0), 1.1f, 1e-6);
+}
+
+TEST(KeepWithinTheSamples, ADarkLineRisesNoHigherThanItsTypicalNeighbour) {
+  // The same pixel on a dark row (a contact shadow: 0.02) with dim pixels above it (0.05) and the
+  // lit ones below (0.1): its neighbours' median is 0.05, so a member's 2 is held there, not at
+  // 0.1 where the bright side would take it.
+  SubBuffer whole = anUnluckyPixel();
+  for (int x = 0; x < 7; ++x)
+    for (int c = 0; c < 3; ++c) {
+      whole.color.mean(x, 3, c) = 0.02f;
+      for (int y = 0; y < 3; ++y) whole.color.mean(x, y, c) = 0.05f;
+    }
+  Image out(7, 7, 3);
+  out.fill(2.0f);
+  keepWithinTheSamples(out, whole, 10.0);
+  EXPECT_NEAR(out(3, 3, 0), 0.05f, 1e-6);
+}
+
+TEST(KeepWithinTheSamples, APixelBesideWhatMostSamplesFindKeepsItsOwnBound) {
+  // Neighbours at 1 with standard error 0.1 from 16 samples are lit by paths most samples find
+  // (p = 1 / (1 + 16 * 0.01), summed over the channels alike: all 16 miss with probability
+  // 0.138^16 = 2e-14 < kUnluckyPixel): the darker centre is dark, not unlucky, and its own
+  // samples bound it: 0.5 + 10 * 0.001.
+  SubBuffer whole = anUnluckyPixel();
+  for (int y = 0; y < 7; ++y)
+    for (int x = 0; x < 7; ++x)
+      for (int c = 0; c < 3; ++c) whole.color.mean(x, y, c) = x == 3 && y == 3 ? 0.5f : 1.0f;
+  Image out(7, 7, 3);
+  out.fill(2.0f);
+  keepWithinTheSamples(out, whole, 10.0);
+  EXPECT_NEAR(out(3, 3, 0), 0.51f, 1e-6);
+}
+
+TEST(KeepWithinTheSamples, AFireflyNextDoorLoosensNothing) {
+  // A well-measured pixel at 1 (standard error 0.1) beside one firefly pixel whose variance is
+  // 1e6: the median of the neighbourhood is still 0.01, so a member that spread the firefly's
+  // 50 onto it is held at 1 + 10 * 0.1 = 2, as without the firefly.
+  SubBuffer whole = constantBuffer(7, 7, 1.0f);
+  whole.sampleCount.fill(16);
+  for (int c = 0; c < 3; ++c) {
+    whole.color.mean(4, 3, c) = 1000.0f;
+    whole.color.varianceOfMean(4, 3, c) = 1e6f;
+  }
+  Image out(7, 7, 3);
+  out.fill(50.0f);
+  keepWithinTheSamples(out, whole, 10.0);
+  EXPECT_NEAR(out(3, 3, 0), 2.0f, 1e-5);
+  EXPECT_EQ(out(4, 3, 0), 50.0f);  // the firefly's own bound: 1000 +- 1e4
+}
+
 TEST(GuardedDenoiser, PartialRunsAreBoundedWhereTheFullRunIs) {
   // Four quarters of a flat image at 1 and a member that answers 5 everywhere. At 4 samples per
   // quarter (a 16-spp render) the full run is bounded by its 16 samples, and the ensemble's

@@ -56,6 +56,45 @@ void finishOutput(Image& output, const Image& noisy) {
   }
 }
 
+namespace {
+
+// The median of channel c of `image` over the (2 kRadius + 1)^2 neighbourhood of (x, y), the
+// pixel itself left out if `withCentre` is false, non-finite values always (0 if none is
+// finite). With an even count, the upper of the two middle values.
+template <int kRadius>
+double neighbourhoodMedian(const Image& image, int x, int y, int c, bool withCentre = true) {
+  float window[(2 * kRadius + 1) * (2 * kRadius + 1)];
+  int n = 0;
+  for (int ny = std::max(0, y - kRadius); ny <= std::min(image.height() - 1, y + kRadius); ++ny)
+    for (int nx = std::max(0, x - kRadius); nx <= std::min(image.width() - 1, x + kRadius); ++nx) {
+      const float v = image(nx, ny, c);
+      if (std::isfinite(v) && (withCentre || nx != x || ny != y)) window[n++] = v;
+    }
+  if (n == 0) return 0.0;
+  std::nth_element(window, window + n / 2, window + n);
+  return window[n / 2];
+}
+
+// Whether all `samples` samples of pixel (x, y) may have missed, by bad luck, the bright paths
+// its neighbours found. Were its 5x5 neighbourhood's typical pixel (medians of mean and
+// variance; the channels together, as one path lights all three) lit only by a path that a
+// sample finds with probability p, its per-sample variance would be mean^2 (1 - p) / p, so
+// p = mean^2 / (mean^2 + per-sample variance), and all `samples` miss it with probability
+// (1 - p)^samples. That is at least kUnluckyPixel only where few samples meet rare paths:
+// with 256 samples a path found by 2 % of them is always met.
+bool mayHaveMissedAll(const SubBuffer& whole, int x, int y, double samples) {
+  double mean = 0.0, deviation = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    mean += neighbourhoodMedian<2>(whole.color.mean, x, y, c);
+    deviation += std::sqrt(neighbourhoodMedian<2>(whole.color.varianceOfMean, x, y, c));
+  }
+  const double perSample = deviation * deviation * samples;
+  if (!(mean > 0.0 && perSample > 0.0)) return false;
+  return std::pow(perSample / (perSample + mean * mean), samples) >= kUnluckyPixel;
+}
+
+}  // namespace
+
 void keepWithinTheSamples(Image& output, const SubBuffer& whole, double sigmas, double minSamples) {
   const Image& mean = whole.color.mean;
   const Image& variance = whole.color.varianceOfMean;
@@ -63,13 +102,26 @@ void keepWithinTheSamples(Image& output, const SubBuffer& whole, double sigmas, 
   if (!whole.sampleCount.sameSize(mean)) return;
   for (int y = 0; y < mean.height(); ++y)
     for (int x = 0; x < mean.width(); ++x) {
-      if (!(whole.sampleCount(x, y, 0) >= minSamples)) continue;
+      const double samples = whole.sampleCount(x, y, 0);
+      if (!(samples >= minSamples)) continue;
       for (int c = 0; c < 3; ++c) {
         const double m = mean(x, y, c), v = variance(x, y, c);
-        if (!(v > 0.0 && std::isfinite(v) && std::isfinite(m))) continue;
-        const double reach = sigmas * std::sqrt(v);
         float& o = output(x, y, c);
-        if (std::isfinite(o)) o = float(std::clamp(double(o), m - reach, m + reach));
+        if (!(v > 0.0 && std::isfinite(v) && std::isfinite(m) && std::isfinite(o))) continue;
+        if (std::abs(o - m) <= sigmas * std::sqrt(v)) continue;
+        // A pixel whose samples all missed its neighbours' rare bright paths is not well
+        // measured, however alike its samples are: up to its eight neighbours' median (not
+        // beyond: a dark line beside a bright side rises to its dim side at most), its 5x5
+        // neighbourhood's median variance bounds it.
+        const double reach = sigmas * std::sqrt(v);
+        double upper = m + reach;
+        if (x > 0 && y > 0 && x + 1 < mean.width() && y + 1 < mean.height()) {
+          const double typical = neighbourhoodMedian<1>(mean, x, y, c, false);
+          if (typical > upper && mayHaveMissedAll(whole, x, y, samples))
+            upper = std::min(typical,
+                             m + sigmas * std::sqrt(neighbourhoodMedian<2>(variance, x, y, c)));
+        }
+        o = float(std::clamp(double(o), m - reach, std::max(upper, m + reach)));
       }
     }
 }

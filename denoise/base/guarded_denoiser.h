@@ -53,11 +53,18 @@ void finishOutput(Image& output, const Image& noisy);
 // where the pixel has at least kMinSamplesToBound samples and a positive variance.
 inline constexpr double kSampleSigmas = 10.0;
 inline constexpr float kMinSamplesToBound = 16.0f;
+// A pixel's samples are taken to have missed its neighbourhood's rare paths by bad luck when
+// that is at least this likely (keepWithinTheSamples).
+inline constexpr double kUnluckyPixel = 0.01;
 
 // In place: every value of `output` within `sigmas` standard errors of `whole`'s mean at pixels
 // with at least `minSamples` samples and a positive variance of the mean. A value that far
 // from the pixel's own samples is another pixel's radiance bled in (a thin highlight or an
 // emitter's edge spread onto a dark, well-measured neighbour), not an estimate of this one.
+// Above, a pixel darker than its neighbours' median whose samples may all have missed the
+// bright paths they found (kUnluckyPixel) is not well measured, however alike its samples are:
+// up to that median, its 5x5 neighbourhood's median variance bounds it (the Cornell box's dark
+// speckles at 16 spp; docs/outliers.md).
 void keepWithinTheSamples(Image& output, const SubBuffer& whole, double sigmas,
                           double minSamples = kMinSamplesToBound);
 

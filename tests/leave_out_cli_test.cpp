@@ -252,6 +252,13 @@ TEST(LeaveOutCli, InfoListsWhatARenderForTheMembersRecordsAndLeavesOut) {
   r = runChorus({"info", (test::sourceDir() / "scenes" / "punctual-lights.gltf").string()});
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("textures: 1 material(s) look textures up"), std::string::npos) << r.out;
+  // Point and spot lights only, never seen: no emission pass; the Cornell box's light is seen.
+  EXPECT_NE(r.out.find("seen emission: none unless --env or --background"), std::string::npos)
+      << r.out;
+  r = runChorus({"info", cornellBox()});
+  EXPECT_NE(r.out.find("seen emission: emissive surfaces seen directly or in mirrors kept out"),
+            std::string::npos)
+      << r.out;
 
   r = runChorus({"info", cornellBox(), "--methods", "atrous,nosuch"});
   EXPECT_EQ(r.exitCode, 2);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "denoise/pipeline/member_planes.h"
+#include "renderer/render.h"
 #include "renderer/scene/gltf_loader.h"
 #include "tools/chorus/command.h"
 #include "tools/chorus/render_denoise.h"
@@ -71,11 +72,22 @@ void printNeeds(const SceneDesc& scene, size_t emissiveTriangles) {
     std::printf("%zu material(s) with a specular layer, metal or transmission\n", layered);
   else
     std::printf("none (every material is Lambertian: no microfacet lobe is evaluated)\n");
+  const bool defaultEnvironment = emissiveTriangles == 0 && scene.lights.empty();
   std::printf("            environment: ");
-  if (emissiveTriangles == 0 && scene.lights.empty())
+  if (defaultEnvironment)
     std::printf("the uniform default (constant: no importance map) unless --env\n");
   else
     std::printf("none unless --env or --background (no environment sampling)\n");
+  // docs/emission.md: seen emission is kept out of the members and pooled with extra rays.
+  std::printf("            seen emission: ");
+  if (emissiveTriangles > 0 || defaultEnvironment)
+    std::printf(
+        "%s kept out of the members; up to %d extra camera rays per pixel where the "
+        "samples disagree on it (--emission-samples)\n",
+        emissiveTriangles > 0 ? "emissive surfaces seen directly or in mirrors" : "the background",
+        RenderOptions{}.emissionSamples);
+  else
+    std::printf("none unless --env or --background (no emission pass)\n");
 }
 
 // What a render for the members of `list` (the --denoise value of `chorus render` that `stage` was

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
+#include "denoise/base/filters/neighbourhood_median.h"
 #include "denoise/base/nonfinite_fill.h"
 #include "denoise/base/radiance_scale.h"
 
@@ -58,21 +60,10 @@ void finishOutput(Image& output, const Image& noisy) {
 
 namespace {
 
-// The median of channel c of `image` over the (2 kRadius + 1)^2 neighbourhood of (x, y), the
-// pixel itself left out if `withCentre` is false, non-finite values always (0 if none is
-// finite). With an even count, the upper of the two middle values.
-template <int kRadius>
-double neighbourhoodMedian(const Image& image, int x, int y, int c, bool withCentre = true) {
-  float window[(2 * kRadius + 1) * (2 * kRadius + 1)];
-  int n = 0;
-  for (int ny = std::max(0, y - kRadius); ny <= std::min(image.height() - 1, y + kRadius); ++ny)
-    for (int nx = std::max(0, x - kRadius); nx <= std::min(image.width() - 1, x + kRadius); ++nx) {
-      const float v = image(nx, ny, c);
-      if (std::isfinite(v) && (withCentre || nx != x || ny != y)) window[n++] = v;
-    }
-  if (n == 0) return 0.0;
-  std::nth_element(window, window + n / 2, window + n);
-  return window[n / 2];
+// The median over the 5x5 neighbourhood of (x, y) of channel c's variance of the mean, as a
+// standard error: how far a typical pixel there lies from its truth.
+double typicalStandardError(const Image& varianceOfMean, int x, int y, int c) {
+  return std::sqrt(double(neighbourhoodMedian<2>(varianceOfMean, x, y, c).value_or(0.0f)));
 }
 
 // Whether all `samples` samples of pixel (x, y) may have missed, by bad luck, the bright paths
@@ -85,8 +76,8 @@ double neighbourhoodMedian(const Image& image, int x, int y, int c, bool withCen
 bool mayHaveMissedAll(const SubBuffer& whole, int x, int y, double samples) {
   double mean = 0.0, deviation = 0.0;
   for (int c = 0; c < 3; ++c) {
-    mean += neighbourhoodMedian<2>(whole.color.mean, x, y, c);
-    deviation += std::sqrt(neighbourhoodMedian<2>(whole.color.varianceOfMean, x, y, c));
+    mean += neighbourhoodMedian<2>(whole.color.mean, x, y, c).value_or(0.0f);
+    deviation += typicalStandardError(whole.color.varianceOfMean, x, y, c);
   }
   const double perSample = deviation * deviation * samples;
   if (!(mean > 0.0 && perSample > 0.0)) return false;
@@ -104,24 +95,29 @@ void keepWithinTheSamples(Image& output, const SubBuffer& whole, double sigmas, 
     for (int x = 0; x < mean.width(); ++x) {
       const double samples = whole.sampleCount(x, y, 0);
       if (!(samples >= minSamples)) continue;
+      const bool inside = x > 0 && y > 0 && x + 1 < mean.width() && y + 1 < mean.height();
+      std::optional<bool> unlucky;  // per pixel (the channels together), only where needed
       for (int c = 0; c < 3; ++c) {
         const double m = mean(x, y, c), v = variance(x, y, c);
         float& o = output(x, y, c);
         if (!(v > 0.0 && std::isfinite(v) && std::isfinite(m) && std::isfinite(o))) continue;
-        if (std::abs(o - m) <= sigmas * std::sqrt(v)) continue;
+        const double reach = sigmas * std::sqrt(v);
+        if (std::abs(o - m) <= reach) continue;
         // A pixel whose samples all missed its neighbours' rare bright paths is not well
         // measured, however alike its samples are: up to its eight neighbours' median (not
         // beyond: a dark line beside a bright side rises to its dim side at most), its 5x5
         // neighbourhood's median variance bounds it.
-        const double reach = sigmas * std::sqrt(v);
         double upper = m + reach;
-        if (x > 0 && y > 0 && x + 1 < mean.width() && y + 1 < mean.height()) {
-          const double typical = neighbourhoodMedian<1>(mean, x, y, c, false);
-          if (typical > upper && mayHaveMissedAll(whole, x, y, samples))
-            upper = std::min(typical,
-                             m + sigmas * std::sqrt(neighbourhoodMedian<2>(variance, x, y, c)));
+        if (inside) {
+          const double typical = neighbourhoodMedian<1>(mean, x, y, c, false).value_or(0.0f);
+          if (typical > upper) {
+            if (!unlucky) unlucky = mayHaveMissedAll(whole, x, y, samples);
+            if (*unlucky)
+              upper = std::max(
+                  upper, std::min(typical, m + sigmas * typicalStandardError(variance, x, y, c)));
+          }
         }
-        o = float(std::clamp(double(o), m - reach, std::max(upper, m + reach)));
+        o = float(std::clamp(double(o), m - reach, upper));
       }
     }
 }

@@ -1,8 +1,11 @@
 #include "denoise/base/nonfinite_fill.h"
 
+#include "denoise/base/filters/neighbourhood_median.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 namespace chorus {
@@ -24,23 +27,21 @@ size_t fillNonFiniteColor(SubBuffer& buffer) {
       std::vector<size_t> rest;
       for (size_t i : missing) {
         const int x = int(i % size_t(w)), y = int(i / size_t(w));
-        std::array<float, 8> values{};
+        const std::optional<float> median = neighbourhoodMedian<1>(mean, x, y, c, false);
+        if (!median) {
+          rest.push_back(i);
+          continue;
+        }
         int count = 0;
         double varianceSum = 0;
         for (int qy = std::max(0, y - 1); qy <= std::min(h - 1, y + 1); ++qy)
           for (int qx = std::max(0, x - 1); qx <= std::min(w - 1, x + 1); ++qx) {
-            const float m = mean(qx, qy, c);
-            if ((qx == x && qy == y) || !std::isfinite(m)) continue;
-            values[size_t(count++)] = m;
+            if ((qx == x && qy == y) || !std::isfinite(mean(qx, qy, c))) continue;
+            ++count;
             const float v = variance(qx, qy, c);
             varianceSum += std::isfinite(v) && v > 0.0f ? double(v) : 0.0;
           }
-        if (count == 0) {
-          rest.push_back(i);
-          continue;
-        }
-        std::nth_element(values.begin(), values.begin() + count / 2, values.begin() + count);
-        ring.push_back({i, {values[size_t(count / 2)], float(varianceSum / count)}});
+        ring.push_back({i, {*median, float(varianceSum / count)}});
       }
       if (ring.empty()) {  // no finite value of this channel anywhere
         for (size_t i : rest) mean.data()[i * 3 + size_t(c)] = 0.0f;

@@ -159,6 +159,33 @@ TEST(EnsembleRunner, TheQuartersEstimateRunsTheHeldOutInputsInsteadOfTheHalves) 
 
 // Progress reports every run once, in order of completion: 0 of N first, then 1 … N, each naming
 // a run of the stage times; the same for members run alone.
+// At 3 spp quarter 3 holds no samples. The run without quarter 2 then has only quarters 0 and 1:
+// they are its halves, instead of (q0 q1 | q3), a half holding nothing, which a member that
+// splits its input denoises as an empty image. The other runs keep their split.
+TEST(HeldOutInputs, AnEmptyQuarterIsNeverAHalf) {
+  SampleBuffers b = buffers(4);
+  b.sub(3) = SubBuffer::zeros(b.width(), b.height(), b.sub(0).planes());
+  ASSERT_EQ(meanSampleCount(b.sub(3)), 0.0);
+  ASSERT_GT(meanSampleCount(b.sub(0)), 0.0);
+  const EnsembleSources sources = sourcesFromBuffers(b);
+  for (int k = 0; k < 4; ++k) {
+    const DenoiseInput input = heldOutInput(sources, k);
+    ASSERT_TRUE(input.halves.has_value());
+    for (const SubBuffer& half : *input.halves)
+      EXPECT_GT(meanSampleCount(half), 0.0) << "without quarter " << k;
+    EXPECT_TRUE(sameImage(input.whole.color.mean,
+                          merge({&(*input.halves)[0], &(*input.halves)[1]}).color.mean))
+        << k;
+  }
+  const DenoiseInput withoutQ2 = heldOutInput(sources, 2);
+  EXPECT_TRUE(sameImage((*withoutQ2.halves)[0].color.mean, b.sub(0).color.mean));
+  EXPECT_TRUE(sameImage((*withoutQ2.halves)[1].color.mean, b.sub(1).color.mean));
+  // Without quarter 0 the split is the usual one: q1 | q2 q3.
+  const DenoiseInput withoutQ0 = heldOutInput(sources, 0);
+  EXPECT_TRUE(sameImage((*withoutQ0.halves)[0].color.mean, b.sub(1).color.mean));
+  EXPECT_TRUE(sameImage((*withoutQ0.halves)[1].color.mean, b.merge({2, 3}).color.mean));
+}
+
 TEST(EnsembleRunner, ReportsEveryRunsEndToTheProgressCallback) {
   const SampleBuffers b = buffers(4);
   for (const MseEstimate estimate : {MseEstimate::Quarters, MseEstimate::Extrapolated}) {

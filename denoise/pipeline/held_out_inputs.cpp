@@ -9,6 +9,12 @@ const SubBuffer& quarter(const EnsembleSources& sources, int k) {
   return (k < 2 ? *sources.a.halves : *sources.b.halves)[size_t(k % 2)];
 }
 
+// A quarter with sample counts that are all 0 (a render at 3 spp: sample i goes to sub-buffer
+// i mod 4, so quarter 3 holds none).
+bool holdsNoSamples(const SubBuffer& quarter) {
+  return quarter.sampleCount.size() > 0 && meanSampleCount(quarter) == 0;
+}
+
 }  // namespace
 
 bool hasQuarters(const EnsembleSources& sources) {
@@ -25,9 +31,17 @@ DenoiseInput heldOutInput(const EnsembleSources& sources, int k) {
   const DenoiseInput& intact = k < 2 ? sources.b : sources.a;
   const SubBuffer& single = quarter(sources, k ^ 1);
   DenoiseInput in;
+  in.sampleShare = 0.75;
+  if (holdsNoSamples(single)) {
+    // Only the intact pair holds samples: its quarters are the halves, since a member that
+    // splits its input would otherwise filter one half holding nothing, and the fold would
+    // misjudge it (docs/ensemble-quality.md "Below 4 spp").
+    in.whole = intact.whole;
+    in.halves = *intact.halves;
+    return in;
+  }
   in.whole = merge({&single, &intact.whole});
   in.halves = std::array<SubBuffer, 2>{single, intact.whole};
-  in.sampleShare = 0.75;
   return in;
 }
 

@@ -5,6 +5,7 @@
 // their own input get the two quarters of the intact half as one half and the remaining
 // quarter as the other (k = 0: q1 | q2 q3, k = 1: q0 | q2 q3, k = 2: q0 q1 | q3, k = 3: q0 q1 |
 // q2): unequal halves, the only split of three quarters that keeps the halves independent.
+// Where that single quarter holds no samples (3 spp), the intact pair's quarters are the halves.
 #include <vector>
 
 #include "common/image/image.h"

@@ -50,8 +50,9 @@ struct RenderArgs {
 // Below this many samples per pixel `chorus render` without --denoise blends the preview's
 // members (K = 2) instead of the default ones: K = 4 leaves sub-buffers empty there, and every
 // rendered corpus entry (128–160 px, chorus render against its reference) blended 1.8–2.5×
-// better in geometric mean on both halves at 1 and 2 spp, but not at 3 (tuning 0.98, validation
-// 1.31: interior-doorway 8.5× worse); docs/ensemble-quality.md, "Below 4 spp".
+// better in geometric mean on both halves at 1 and 2 spp (still 0.84 / 0.94 since held-out runs
+// take no empty quarter as a half), but not at 3 (tuning 0.98, validation 1.04: interior-doorway
+// 4× worse; at 512 px tuning 1.11); docs/ensemble-quality.md, "Below 4 spp".
 constexpr int kDefaultMembersFromSpp = 3;
 
 bool previewMembersForFewSamples(const RenderArgs& args) {

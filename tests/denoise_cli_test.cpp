@@ -336,8 +336,8 @@ TEST(DenoiseCli, WarnsWhenSubBuffersHoldNoSamples) {
       }
       const std::string warning =
           input +
-          ": 2 of its 4 sub-buffers hold no samples, and the members run on them too: "
-          "render at least 4 spp (or, below 3 spp, denoise in chorus render)";
+          ": 2 of its 4 sub-buffers hold no samples, which leaves the members and their weights "
+          "less to work with: render at least 4 spp (or, below 3 spp, denoise in chorus render)";
       EXPECT_EQ(warnings, json({warning}));
       EXPECT_EQ(r.err, quiet ? "" : "chorus: warning: " + warning + "\n");
     }

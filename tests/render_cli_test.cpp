@@ -182,8 +182,8 @@ TEST(RenderCli, WarnsWhenSubBuffersGetNoSamples) {
     return std::make_pair(r.err, readJson(dir / name / "stats.json")["warnings"]);
   };
   const std::string warning =
-      "1 of the 2 sub-buffers get no samples at 1 spp, and the members run on them too: render at "
-      "least 2 spp";
+      "1 of the 2 sub-buffers get no samples at 1 spp, which leaves the members and their weights "
+      "less to work with: render at least 2 spp";
   auto [err, warnings] = run("1", "atrous", "one", false);
   EXPECT_NE(err.find("chorus: warning: " + warning + "\n"), std::string::npos) << err;
   EXPECT_EQ(warnings, json({warning}));

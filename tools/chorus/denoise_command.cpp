@@ -128,7 +128,8 @@ std::string emptySubBuffersWarning(const ReadInput& input) {
   }
   if (empty == 0) return {};
   return input.path.string() + ": " + std::to_string(empty) + " of its " + std::to_string(splits) +
-         " sub-buffers hold no samples, and the members run on them too: render at least " +
+         " sub-buffers hold no samples, which leaves the members and their weights less to work "
+         "with: render at least " +
          std::to_string(splits) + " spp (or, below 3 spp, denoise in chorus render)";
 }
 

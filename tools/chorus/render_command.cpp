@@ -86,15 +86,16 @@ DenoiseStage denoiseStageOf(const RenderArgs& args) {
 }
 
 // Sample i of a pixel goes to sub-buffer i mod K: below K samples per pixel some sub-buffers
-// stay empty, and the members' runs on them (and the estimate that compares them) have nothing to
-// work with (Cornell box 64², default members: NFOR 3.1x worse than the noisy input at 2 spp, the
-// blend 0.141 against the preview's 0.063). Empty when the run denoises at K spp or more.
+// stay empty, and the members' runs (some of whose halves are empty at 1-2 spp) and the estimate
+// that compares them have less to work with (Cornell box 64², default members: NFOR 3.1x worse
+// than the noisy input at 2 spp; the blend 0.141 against the preview's 0.063; at 3 spp on the
+// Cornell box 512² still 1.6x NFOR's full run). Empty when the run denoises at K spp or more.
 std::string fewSamplesWarning(const DenoiseStage& denoise, const RenderOptions& options) {
   if (!denoise.enabled() || options.spp >= options.splits) return {};
   const int empty = options.splits - options.spp;
   return std::to_string(empty) + " of the " + std::to_string(options.splits) +
          " sub-buffers get no samples at " + std::to_string(options.spp) +
-         " spp, and the members run on them too: render at least " +
+         " spp, which leaves the members and their weights less to work with: render at least " +
          std::to_string(options.splits) + " spp" +
          (options.splits == 4 ? ", or --preview (2 sub-buffers)" : "");
 }

@@ -95,8 +95,9 @@ void runMerge(const SweepArgs& args) {
 }
 
 // Every case renders K = kCaseSplits sub-buffers (sample i to sub-buffer i mod K): below K spp
-// some stay empty and the members run on them too (docs/ensemble-quality.md, "Below 4 spp").
-// Said at the end of a sweep that succeeded, so that a failing one prints its one error line only.
+// some stay empty, and the members and their weights have less to work with
+// (docs/ensemble-quality.md, "Below 4 spp"). Said at the end of a sweep that succeeded, so that a
+// failing one prints its one error line only.
 std::string lowSppWarning(const std::vector<int>& spps) {
   constexpr int k = sweep::kCaseSplits;
   std::string few;
@@ -104,7 +105,8 @@ std::string lowSppWarning(const std::vector<int>& spps) {
     if (spp < k) few += (few.empty() ? "" : ", ") + std::to_string(spp);
   if (few.empty()) return {};
   return "at " + few + " spp some of the " + std::to_string(k) +
-         " sub-buffers get no samples, and the members ran on them too (chorus render denoises "
+         " sub-buffers get no samples, which left the members and their weights less to work "
+         "with (chorus render denoises "
          "with the preview's members below 3 spp)";
 }
 

@@ -157,8 +157,6 @@ TEST(EnsembleRunner, TheQuartersEstimateRunsTheHeldOutInputsInsteadOfTheHalves) 
   EXPECT_TRUE(two.bases[0].heldOut.empty());
 }
 
-// Progress reports every run once, in order of completion: 0 of N first, then 1 … N, each naming
-// a run of the stage times; the same for members run alone.
 // At 3 spp quarter 3 holds no samples. The run without quarter 2 then has only quarters 0 and 1:
 // they are its halves, instead of (q0 q1 | q3), a half holding nothing, which a member that
 // splits its input denoises as an empty image. The other runs keep their split.
@@ -186,6 +184,8 @@ TEST(HeldOutInputs, AnEmptyQuarterIsNeverAHalf) {
   EXPECT_TRUE(sameImage((*withoutQ0.halves)[1].color.mean, b.merge({2, 3}).color.mean));
 }
 
+// Progress reports every run once, in order of completion: 0 of N first, then 1 … N, each naming
+// a run of the stage times; the same for members run alone.
 TEST(EnsembleRunner, ReportsEveryRunsEndToTheProgressCallback) {
   const SampleBuffers b = buffers(4);
   for (const MseEstimate estimate : {MseEstimate::Quarters, MseEstimate::Extrapolated}) {

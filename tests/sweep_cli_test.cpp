@@ -75,9 +75,8 @@ TEST(SweepCli, WarnsAboutSampleCountsBelowFour) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const std::string warning =
       "chorus: warning: at 1, 3 spp some of the 4 sub-buffers get no samples, which left the "
-      "members "
-      "and their weights less to work with (chorus render denoises with the preview's members "
-      "below 3 spp)\n";
+      "members and their weights less to work with (chorus render denoises with the preview's "
+      "members below 3 spp)\n";
   EXPECT_NE(r.err.find(warning), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("warning"), r.err.rfind("warning")) << r.err;  // once
   r = runChorus(tinySweep(dir / "quiet", {"--spp", "2", "--quiet"}));

@@ -278,6 +278,12 @@ double meanSampleCount(const SubBuffer& buffer) {
   return total / double(counts.size());
 }
 
+bool holdsNoSamples(const SubBuffer& buffer) {
+  const Image& counts = buffer.sampleCount;
+  return counts.size() > 0 && std::all_of(counts.values().begin(), counts.values().end(),
+                                          [](float n) { return n == 0; });
+}
+
 double renderSamplesPerPixel(const SubBuffer& buffer, double sampleShare) {
   return sampleShare > 0 ? meanSampleCount(buffer) / sampleShare : 0.0;
 }

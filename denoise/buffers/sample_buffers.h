@@ -83,6 +83,9 @@ struct SubBuffer {
 
 // The mean sample count over the pixels (0 when the buffer records none).
 double meanSampleCount(const SubBuffer& buffer);
+// Whether the buffer records sample counts and every one is 0: a sub-buffer of a render below K
+// spp (sample i goes to sub-buffer i mod K).
+bool holdsNoSamples(const SubBuffer& buffer);
 
 // Exact merge of independent sub-buffers (Chan et al.'s parallel mean/M2 update, weighted by
 // sample counts): the result equals accumulating all their samples into one buffer. The parts

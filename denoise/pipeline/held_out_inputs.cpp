@@ -9,12 +9,6 @@ const SubBuffer& quarter(const EnsembleSources& sources, int k) {
   return (k < 2 ? *sources.a.halves : *sources.b.halves)[size_t(k % 2)];
 }
 
-// A quarter with sample counts that are all 0 (a render at 3 spp: sample i goes to sub-buffer
-// i mod 4, so quarter 3 holds none).
-bool holdsNoSamples(const SubBuffer& quarter) {
-  return quarter.sampleCount.size() > 0 && meanSampleCount(quarter) == 0;
-}
-
 }  // namespace
 
 bool hasQuarters(const EnsembleSources& sources) {

@@ -11,7 +11,6 @@
 // input can feed which member.
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -28,6 +27,7 @@
 #include "common/thread_limit.h"
 #include "denoise/base/registry.h"
 #include "denoise/buffers/buffers_exr.h"
+#include "denoise/buffers/sample_buffers.h"
 #include "denoise/buffers/tungsten_dir.h"
 #include "denoise/ensemble/outputs_directory.h"
 #include "denoise/pipeline/ensemble.h"
@@ -113,18 +113,17 @@ std::string inputHint(const ReadInput& input, bool alone) {
 }
 
 // A render.exr below K spp has sub-buffers without a sample (sample i goes to sub-buffer
-// i mod K): the members' runs on them, and the ensemble's estimate that compares them, have
-// nothing to work with (docs/ensemble-quality.md, "Below 4 spp"). Empty when every sub-buffer
-// holds samples, or the render recorded no counts.
+// i mod K): the members' runs and the ensemble's estimate have less to work with
+// (docs/ensemble-quality.md, "Below 4 spp"). Empty when every sub-buffer holds samples, or the
+// render recorded no counts.
 std::string emptySubBuffersWarning(const ReadInput& input) {
   if (!input.render) return {};
   const int splits = input.render->splitCount();
   int empty = 0;
   for (int k = 0; k < splits; ++k) {
-    const Image& count = input.render->sub(k).sampleCount;
-    if (count.empty()) return {};
-    empty += std::all_of(count.values().begin(), count.values().end(),
-                         [](float n) { return n == 0.0f; });
+    const SubBuffer& buffer = input.render->sub(k);
+    if (buffer.sampleCount.empty()) return {};
+    empty += holdsNoSamples(buffer);
   }
   if (empty == 0) return {};
   return input.path.string() + ": " + std::to_string(empty) + " of its " + std::to_string(splits) +

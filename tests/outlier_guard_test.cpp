@@ -128,6 +128,62 @@ TEST(OutlierGuard, FirefliesWithPeersKeepTheirEnergy) {
   EXPECT_LT(largest, 0.2f * 300.0f / 4.0f);
 }
 
+// A wall lit only by rare paths (docs/outliers.md's corridor at 4 spp): every sample is 0 but
+// one of the four at every fifth pixel across and down, which is 200. No 5 × 5 neighbourhood
+// holds another, so the RMS test alone dropped them all and the wall went black; the spread
+// window holds several on the same surface, filling an area, so each is spread: the wall keeps
+// its light and loses its peaks.
+SubBuffer sparseTail(const std::function<float(int x, int y)>& depth) {
+  SubBuffer s = fromSamples(48, 48, [](int x, int y) {
+    std::vector<double> v = {0, 0, 0, 0};
+    if (x % 5 == 0 && y % 5 == 0) v[0] = 200.0;
+    return v;
+  });
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 48; ++x) s.depth.mean(x, y, 0) = depth(x, y);
+  return s;
+}
+
+TEST(OutlierGuard, ASparseTailOverAnAreaKeepsItsEnergy) {
+  const SubBuffer s = sparseTail([](int, int) { return 2.0f; });
+  const GuardedInput g = guardOutliers(wholeOnly(s));
+  EXPECT_GT(g.clampedValues, 0u);
+  const double before = channelSum(s.color.mean), after = channelSum(g.input.whole.color.mean);
+  EXPECT_NEAR(after, before, 1e-5 * before);
+  float largest = 0;
+  for (float v : g.input.whole.color.mean.values()) largest = std::max(largest, v);
+  EXPECT_LT(largest, 0.2f * 200.0f / 4.0f);
+}
+
+// The same samples, but every 5 × 5 block is a surface of its own depth (1.5 times or less
+// than a third of every other's): no sample has a peer on its surface, so
+// each is dropped, as a lone firefly is.
+TEST(OutlierGuard, TailSamplesOnOtherSurfacesAreNotPeers) {
+  const SubBuffer s =
+      sparseTail([](int x, int y) { return std::pow(1.5f, float(x / 5 + 10 * (y / 5))); });
+  const GuardedInput g = guardOutliers(wholeOnly(s));
+  EXPECT_GT(g.clampedValues, 0u);
+  EXPECT_LT(channelSum(g.input.whole.color.mean), 1e-3 * channelSum(s.color.mean));
+}
+
+// Tail samples along a line (every third pixel of row 20: a light's edge, a glint) have peers in
+// the spread window, but on a line, not over an area: their excess belongs to the line, and
+// spread over the window it became a halo beside it. It is dropped; the rows beside it keep
+// their values.
+TEST(OutlierGuard, ALineOfTailSamplesIsNotSpreadBesideIt) {
+  const SubBuffer s = fromSamples(48, 48, [](int x, int y) {
+    std::vector<double> v = {0.01, 0.01, 0.01, 0.01};
+    if (y == 20 && x % 3 == 0) v[0] = 200.0;
+    return v;
+  });
+  const GuardedInput g = guardOutliers(wholeOnly(s));
+  EXPECT_GT(g.clampedValues, 0u);
+  for (int x = 0; x < 48; ++x) {
+    EXPECT_EQ(g.input.whole.color.mean(x, 18, 0), s.color.mean(x, 18, 0)) << x;
+    EXPECT_EQ(g.input.whole.color.mean(x, 22, 0), s.color.mean(x, 22, 0)) << x;
+  }
+}
+
 // spread=R (the previews take 12): the same caustic's excess over a wider window keeps the same
 // energy in a fainter, wider blob.
 TEST(OutlierGuard, AWiderSpreadKeepsTheEnergyInAFainterBlob) {

@@ -132,6 +132,28 @@ double sameOrientation(const float* a, const float* b) {
   return std::exp(-0.5 * d2 / (kSpreadNormalSigma * kSpreadNormalSigma));
 }
 
+// How much pixel q sees what pixel p sees: the product of the three similarities above over
+// the features the part holds (one it does not hold counts as the same).
+class WhatItSees {
+ public:
+  explicit WhatItSees(const SubBuffer& part)
+      : depth_(part.depth.mean),
+        albedo_(part.albedo.mean),
+        normal_(part.normal.mean),
+        hasDepth_(depth_.sameSize(part.color.mean)),
+        hasAlbedo_(albedo_.sameSize(part.color.mean)),
+        hasNormal_(normal_.sameSize(part.color.mean)) {}
+  double shared(int px, int py, int qx, int qy) const {
+    return (hasDepth_ ? sameSurface(depth_(px, py, 0), depth_(qx, qy, 0)) : 1.0) *
+           (hasAlbedo_ ? sameMaterial(albedo_.pixel(px, py), albedo_.pixel(qx, qy)) : 1.0) *
+           (hasNormal_ ? sameOrientation(normal_.pixel(px, py), normal_.pixel(qx, qy)) : 1.0);
+  }
+
+ private:
+  const Image &depth_, &albedo_, &normal_;
+  bool hasDepth_, hasAlbedo_, hasNormal_;
+};
+
 // The value exceeded by exactly `rank` of values[0 … count) (0: the largest), for a small rank:
 // the running top rank + 1 in insertion order.
 float largest(const float* values, int count, int rank) {
@@ -224,6 +246,11 @@ void rankNeighbours(int r, NeighbourRanks& ranks) {
   }
 }
 
+// tailFillsTheWindow's peers: at least 1 / kPeerFraction of the outlier's excess each, spread
+// over at least kPeerAreaSpread px² (the smaller variance of their positions).
+constexpr double kPeerFraction = 4.0;
+constexpr double kPeerAreaSpread = 2.0;
+
 class PartGuard {
  public:
   PartGuard(const SubBuffer& part, const SubBuffer* other, const OutlierGuardOptions& options)
@@ -265,6 +292,42 @@ class PartGuard {
     const double wanted =
         std::sqrt(2.0 * amount / (std::numbers::pi * o_.spreadPeak * (level + noise)));
     return wanted > r ? int(std::ceil(std::min(wanted, double(kMaxGuardSpread)))) : r;
+  }
+
+  // Whether the outlier at (x, y) is one sample of a tail that is spread over an area of its
+  // surface around it, though its 5 × 5 neighbourhood may hold no other: over the spread window
+  // (radius spreadRadius), the neighbours whose excess over the level is at least
+  // 1 / kPeerFraction of the outlier's, weighted by how much they see what it sees, must hold
+  // together at least as much excess as it does, and fill an area rather than a line: the
+  // smaller eigenvalue of the covariance of their positions (weighted by excess, the outlier's
+  // own included) is at least kPeerAreaSpread px². Spreading such an excess keeps the surface's
+  // light; dropping it darkened whole walls lit by rare paths (a corridor at 4 spp lost 7 % of
+  // its light and NFOR doubled its error: docs/outliers.md). A bright line (a light's edge, a
+  // glint) is not such a tail: its excess spread over the window became a halo beside it.
+  bool tailFillsTheWindow(int x, int y, int c, double level, double excess) const {
+    const Image& mean = part_.color.mean;
+    const int w = mean.width(), h = mean.height(), r = o_.spreadRadius;
+    const WhatItSees sees(part_);
+    double mass = 0, sw = excess, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+    for (int qy = std::max(0, y - r); qy <= std::min(h - 1, y + r); ++qy)
+      for (int qx = std::max(0, x - r); qx <= std::min(w - 1, x + r); ++qx) {
+        const double d = double(mean(qx, qy, c)) - level;
+        if ((qx == x && qy == y) || !(std::isfinite(d) && d * kPeerFraction >= excess)) continue;
+        const double m = d * sees.shared(x, y, qx, qy);
+        const double dx = qx - x, dy = qy - y;
+        mass += m;
+        sw += m;
+        sx += m * dx;
+        sy += m * dy;
+        sxx += m * dx * dx;
+        syy += m * dy * dy;
+        sxy += m * dx * dy;
+      }
+    if (!(mass >= excess)) return false;
+    const double mx = sx / sw, my = sy / sw;
+    const double a = sxx / sw - mx * mx, b = sxy / sw - mx * my, d = syy / sw - my * my;
+    const double smaller = 0.5 * (a + d) - std::sqrt(0.25 * (a - d) * (a - d) + b * b);
+    return smaller >= kPeerAreaSpread;
   }
 
   // The Gaussians g of spread by radius, g(dx, dy) at |dy| (r + 1) + |dx|: computed once per
@@ -311,12 +374,7 @@ class PartGuard {
         totals[i] = total;
       }
     });
-    const Image& depth = part_.depth.mean;
-    const bool hasDepth = depth.sameSize(part_.color.mean);
-    const Image& albedo = part_.albedo.mean;
-    const bool hasAlbedo = albedo.sameSize(part_.color.mean);
-    const Image& normal = part_.normal.mean;
-    const bool hasNormal = normal.sameSize(part_.color.mean);
+    const WhatItSees sees(part_);
     parallelRows(0, h, [&](int y) {
       // The excesses whose windows can reach row y: e.y within kMaxGuardSpread of it.
       auto first = std::lower_bound(excesses.begin(), excesses.end(), y - kMaxGuardSpread,
@@ -326,16 +384,10 @@ class PartGuard {
         const int r = e.radius, dy = std::abs(y - e.y);
         if (dy > r) continue;
         const std::vector<double>& g = kernels.byRadius[size_t(r)];
-        // What the outlier's pixel sees (features the input does not hold count as the same).
-        const double here = hasDepth ? depth(e.x, e.y, 0) : 0.0;
-        const float* material = hasAlbedo ? albedo.pixel(e.x, e.y) : nullptr;
-        const float* facing = hasNormal ? normal.pixel(e.x, e.y) : nullptr;
         const double total = totals[size_t(it - excesses.begin())];
         for (int x = std::max(0, e.x - r); x <= std::min(w - 1, e.x + r); ++x) {
-          const double share = g[size_t(dy * (r + 1) + std::abs(x - e.x))] *
-                               (hasDepth ? sameSurface(here, depth(x, y, 0)) : 1.0) *
-                               (material ? sameMaterial(material, albedo.pixel(x, y)) : 1.0) *
-                               (facing ? sameOrientation(facing, normal.pixel(x, y)) : 1.0) / total;
+          const double share =
+              g[size_t(dy * (r + 1) + std::abs(x - e.x))] * sees.shared(e.x, e.y, x, y) / total;
           float& m = out.mean(x, y, e.c);
           m = float(std::min(double(m) + e.amount * share, double(kMaxFloat)));
           changed[size_t(y) * size_t(w) + size_t(x)] = 1;
@@ -452,7 +504,8 @@ class PartGuard {
         double squares = 0;
         for (int i = 0; i < count; ++i) squares += (first[i] - level) * (first[i] - level);
         const double surplus = value - clampedValue;
-        if (value - level <= o_.peerSigmas * std::sqrt(squares / count))
+        if (value - level <= o_.peerSigmas * std::sqrt(squares / count) ||
+            tailFillsTheWindow(x, y, c, level, value - level))
           excesses.push_back({x, y, c, surplus, spreadRadiusFor(surplus, level, noise)});
         const double excess = clampedValue - level;
         const double cap = std::max(noise * noise, excess * excess);

@@ -21,8 +21,12 @@
 // (2 R + 1)² window around it (Gaussian weights, σ = R / 2, times Gaussians in the relative
 // depth and albedo differences and in the normals' difference: what the outlier's pixel sees
 // only; what would fall elsewhere is dropped) when it has peers: x − L ≤ peerSigmas × the RMS
-// deviation of the neighbours from L, i.e. a few neighbours deviate as much. Such outliers are
-// the samples of a heavy-tailed distribution that is really there (caustic paths): dropping
+// deviation of the neighbours from L, i.e. a few neighbours deviate as much, or when the
+// (2 R + 1)² window holds, on what the outlier's pixel sees, values at least a quarter as far
+// above L that together stand as far above it as the outlier does and fill an area, not a line
+// (a wall lit by rare paths at a few samples, whose 5 × 5 neighbourhoods seldom hold two; a
+// light's edge or a glint is a line, whose excess spread beside it became a halo). Such
+// outliers are the samples of a heavy-tailed distribution that is really there: dropping
 // them would darken the caustic at any sample count the guard still acts at; spread, they keep
 // its energy in the window and lose only their variance. R = spreadRadius, or where L > 0
 // and the blob would peak above spreadPeak × (L + σ_N), the radius at which it does not (at

@@ -441,6 +441,422 @@ def chrome_candles(directory):
     gltf.write(directory, embed_buffer=True)
 
 
+# ---------------------------------------------------------------------------------------------
+# A report-only set (added 2026-12-07, seventeenth session): nine scenes of kinds the corpus lacks,
+# never tuned on, measured with `chorus sweep` (docs/evaluation.md, "The fresh set").
+
+
+def closed_room(gltf, w, d, h, floor, wall):
+    """A room of half width w (x), half depth d (z) and height h, every side closed; the floor's
+    texture repeats three times."""
+    add_quad(gltf, "floor", [(-w, 0, d), (w, 0, d), (w, 0, -d), (-w, 0, -d)], (0, 1, 0), floor,
+             uv_scale=(3, 3))
+    add_quad(gltf, "ceiling", [(-w, h, -d), (w, h, -d), (w, h, d), (-w, h, d)], (0, -1, 0), wall)
+    add_quad(gltf, "back", [(-w, 0, -d), (w, 0, -d), (w, h, -d), (-w, h, -d)], (0, 0, 1), wall)
+    add_quad(gltf, "front", [(-w, 0, d), (w, 0, d), (w, h, d), (-w, h, d)], (0, 0, -1), wall)
+    add_quad(gltf, "left", [(-w, 0, -d), (-w, 0, d), (-w, h, d), (-w, h, -d)], (1, 0, 0), wall)
+    add_quad(gltf, "right", [(w, 0, -d), (w, 0, d), (w, h, d), (w, h, -d)], (-1, 0, 0), wall)
+
+
+@scene
+def corridor(directory):
+    """A long corridor lit by a bright window at its far end and two small ceiling lamps:
+    the near walls, seen at grazing angles, are lit only by rare paths (the scene that
+    showed the guard dropping a sparse tail's light, docs/outliers.md)."""
+    gltf = gs.Gltf("corridor")
+    wall = gs.lambertian(gltf, "plaster", (0.7, 0.68, 0.62))
+    floor = textured(gltf, "planks", planks_png(), roughness=0.35)
+    w, h, L = 0.8, 2.2, 12.0
+    add_quad(
+        gltf,
+        "floor",
+        [(-w, 0, 1), (w, 0, 1), (w, 0, -L), (-w, 0, -L)],
+        (0, 1, 0),
+        floor,
+        uv_scale=(1, 8),
+    )
+    add_quad(gltf, "ceiling", [(-w, h, -L), (w, h, -L), (w, h, 1), (-w, h, 1)], (0, -1, 0), wall)
+    add_quad(gltf, "left", [(-w, 0, -L), (-w, 0, 1), (-w, h, 1), (-w, h, -L)], (1, 0, 0), wall)
+    add_quad(gltf, "right", [(w, 0, -L), (w, 0, 1), (w, h, 1), (w, h, -L)], (-1, 0, 0), wall)
+    add_quad(
+        gltf,
+        "end light",
+        [(-w, 0, -L), (w, 0, -L), (w, h, -L), (-w, h, -L)],
+        (0, 0, 1),
+        emissive(gltf, "window", (1.0, 0.97, 0.9), 20.0),
+    )
+    for i, z in enumerate((-3.0, -6.5)):
+        add_quad(
+            gltf,
+            "lamp%d" % i,
+            [
+                (-0.1, h - 0.005, z - 0.1),
+                (0.1, h - 0.005, z - 0.1),
+                (0.1, h - 0.005, z + 0.1),
+                (-0.1, h - 0.005, z + 0.1),
+            ],
+            (0, -1, 0),
+            emissive(gltf, "lamp%d" % i, (1.0, 0.8, 0.5), 40.0),
+        )
+    add_box(
+        gltf,
+        "bench",
+        gltf.material("steel", (0.7, 0.7, 0.72), 1.0, 0.3),
+        (0.5, 0.25, -2.0),
+        (0.4, 0.5, 1.2),
+    )
+    add_camera(gltf, (0.0, 1.5, 0.5), (0.0, 1.0, -6.0), 55.0, 1.5)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+@scene
+def attic(directory):
+    """An attic lit only through a narrow skylight behind a beam, noise-textured walls and a
+    plank floor: nearly every pixel is lit by bounces."""
+    gltf = gs.Gltf("attic")
+    wall = textured(gltf, "noise wall", noise_png(), roughness=0.9)
+    floor = textured(gltf, "planks", planks_png(), roughness=0.5)
+    w, dd, h = 1.5, 2.0, 2.2
+    add_quad(
+        gltf,
+        "floor",
+        [(-w, 0, dd), (w, 0, dd), (w, 0, -dd), (-w, 0, -dd)],
+        (0, 1, 0),
+        floor,
+        uv_scale=(2, 2),
+    )
+    # ceiling with a skylight hole: two quads leaving a gap around z in [-0.3, 0.3]
+    add_quad(
+        gltf, "ceil a", [(-w, h, -dd), (w, h, -dd), (w, h, -0.3), (-w, h, -0.3)], (0, -1, 0), wall
+    )
+    add_quad(gltf, "ceil b", [(-w, h, 0.3), (w, h, 0.3), (w, h, dd), (-w, h, dd)], (0, -1, 0), wall)
+    add_quad(gltf, "back", [(-w, 0, -dd), (w, 0, -dd), (w, h, -dd), (-w, h, -dd)], (0, 0, 1), wall)
+    add_quad(gltf, "front", [(-w, 0, dd), (w, 0, dd), (w, h, dd), (-w, h, dd)], (0, 0, -1), wall)
+    add_quad(gltf, "left", [(-w, 0, -dd), (-w, 0, dd), (-w, h, dd), (-w, h, -dd)], (1, 0, 0), wall)
+    add_quad(gltf, "right", [(w, 0, -dd), (w, 0, dd), (w, h, dd), (w, h, -dd)], (-1, 0, 0), wall)
+    add_quad(
+        gltf,
+        "sky panel",
+        [(-w, h + 0.6, -0.3), (w, h + 0.6, -0.3), (w, h + 0.6, 0.3), (-w, h + 0.6, 0.3)],
+        (0, -1, 0),
+        emissive(gltf, "sky", (0.8, 0.9, 1.0), 30.0),
+    )
+    add_box(
+        gltf,
+        "beam",
+        gs.lambertian(gltf, "dark wood", (0.3, 0.2, 0.12)),
+        (0, h - 0.2, 0),
+        (2 * w, 0.25, 0.25),
+    )
+    add_box(
+        gltf,
+        "chest",
+        gs.lambertian(gltf, "green", (0.2, 0.5, 0.25)),
+        (0.6, 0.3, -0.8),
+        (0.8, 0.6, 0.5),
+        yaw=12,
+    )
+    add_sphere(
+        gltf, "silver", gltf.material("silver", (0.9, 0.9, 0.92), 1.0, 0.15), (-0.5, 0.3, 0.2), 0.3
+    )
+    add_camera(gltf, (-1.2, 1.4, 1.8), (0.3, 0.7, -0.8), 60.0, 1.5)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+@scene
+def bathroom(directory):
+    """The Cornell room with a glossy tiled floor, a chrome ball, an enamel tub and a blue
+    glass sphere under a ceiling light."""
+    gltf = gs.Gltf("bathroom")
+    tiles = textured(gltf, "tiles", fine_checker_png(128, 16), roughness=0.1)
+    white = cornell_room(gltf, tiles)
+    add_quad(
+        gltf,
+        "light",
+        [(-0.4, 1.995, -0.2), (0.4, 1.995, -0.2), (0.4, 1.995, 0.2), (-0.4, 1.995, 0.2)],
+        (0, -1, 0),
+        emissive(gltf, "lamp", (1.0, 0.95, 0.9), 12.0),
+    )
+    add_sphere(
+        gltf,
+        "chrome",
+        gltf.material("chrome", (0.95, 0.95, 0.95), 1.0, 0.02),
+        (-0.4, 0.3, 0.1),
+        0.3,
+    )
+    add_box(
+        gltf,
+        "tub",
+        gltf.material("enamel", (0.9, 0.9, 0.88), 0.0, 0.2),
+        (0.35, 0.25, -0.3),
+        (0.6, 0.5, 0.9),
+        yaw=-10,
+    )
+    add_sphere(gltf, "soap", glass(gltf, "blue glass", (0.6, 0.8, 1.0)), (0.2, 0.15, 0.5), 0.15)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+@scene
+def garden(directory):
+    """Twenty boxes of five materials (plastic, gold, rough green, chrome, glossy blue) on a
+    fine checker ground, for an environment map: much geometric detail."""
+    gltf = gs.Gltf("garden")
+    ground = textured(gltf, "checker", fine_checker_png(128, 4), roughness=0.8)
+    add_quad(
+        gltf,
+        "ground",
+        [(-6, 0, 6), (6, 0, 6), (6, 0, -6), (-6, 0, -6)],
+        (0, 1, 0),
+        ground,
+        uv_scale=(6, 6),
+    )
+    mats = [
+        gltf.material("m%d" % i, c, m, r)
+        for i, (c, m, r) in enumerate(
+            [
+                ((0.8, 0.2, 0.2), 0, 0.3),
+                ((0.9, 0.8, 0.4), 1, 0.25),
+                ((0.2, 0.6, 0.3), 0, 0.8),
+                ((0.8, 0.8, 0.85), 1, 0.05),
+                ((0.3, 0.3, 0.8), 0, 0.1),
+            ]
+        )
+    ]
+    k = 0
+    for i in range(5):
+        for j in range(4):
+            h = 0.2 + 0.15 * ((i * 7 + j * 3) % 5)
+            add_box(
+                gltf,
+                "b%d_%d" % (i, j),
+                mats[k % 5],
+                (-1.2 + 0.6 * i, h / 2, -1.0 + 0.6 * j),
+                (0.3, h, 0.3),
+                yaw=(i * 17 + j * 29) % 90,
+            )
+            k += 1
+    add_camera(gltf, (0.0, 1.8, 3.2), (0.0, 0.2, -0.2), 45.0, 1.5)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+@scene
+def stage(directory):
+    """A spot light on a white ball before a red curtain, a rough gold box and a blue point
+    light behind: hard-edged light pools on a dark glossy floor."""
+    gltf = gs.Gltf("stage")
+    floor = gltf.material("dark floor", (0.05, 0.05, 0.06), 0.0, 0.3)
+    add_quad(gltf, "floor", [(-4, 0, 4), (4, 0, 4), (4, 0, -4), (-4, 0, -4)], (0, 1, 0), floor)
+    add_quad(
+        gltf,
+        "curtain",
+        [(-4, 0, -1.5), (4, 0, -1.5), (4, 3, -1.5), (-4, 3, -1.5)],
+        (0, 0, 1),
+        gs.lambertian(gltf, "red curtain", (0.5, 0.05, 0.05)),
+    )
+    add_sphere(gltf, "ball", gs.lambertian(gltf, "white", (0.8, 0.8, 0.8)), (0.0, 0.5, 0.0), 0.5)
+    add_box(
+        gltf,
+        "box",
+        gltf.material("rough gold", (1.0, 0.78, 0.34), 1.0, 0.35),
+        (1.1, 0.3, -0.5),
+        (0.6, 0.6, 0.6),
+        yaw=30,
+    )
+    gltf.doc["extensions"] = {
+        "KHR_lights_punctual": {
+            "lights": [
+                {
+                    "name": "spot",
+                    "type": "spot",
+                    "color": [1.0, 0.95, 0.85],
+                    "intensity": 60.0,
+                    "spot": {"innerConeAngle": 0.1, "outerConeAngle": 0.25},
+                },
+                {"name": "rim", "type": "point", "color": [0.3, 0.5, 1.0], "intensity": 4.0},
+            ]
+        }
+    }
+    gltf.extensions.add("KHR_lights_punctual")
+    s = [0.5, 3.0, 2.0]
+    gltf.node(
+        "spot",
+        translation=s,
+        rotation=gs.look_at_rotation(s, [0, 0.4, 0]),
+        extensions={"KHR_lights_punctual": {"light": 0}},
+    )
+    gltf.node(
+        "rim", translation=[-0.8, 1.2, -1.0], extensions={"KHR_lights_punctual": {"light": 1}}
+    )
+    add_camera(gltf, (0.0, 1.3, 3.5), (0.0, 0.5, 0.0), 40.0, 1.5)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+@scene
+def library(directory):
+    """A room lit by a window in its side wall, four shelves of books (many small boxes), a
+    brass globe and a plank floor."""
+    gltf = gs.Gltf("library")
+    wall = gs.lambertian(gltf, "cream", (0.8, 0.75, 0.65))
+    floor = textured(gltf, "planks", planks_png(), roughness=0.4)
+    w, dd, h = 2.0, 2.0, 2.5
+    closed_room(gltf, w, dd, h, floor, wall)
+    add_quad(
+        gltf,
+        "window",
+        [
+            (-w + 0.01, 1.0, -0.6),
+            (-w + 0.01, 1.0, 0.6),
+            (-w + 0.01, 2.0, 0.6),
+            (-w + 0.01, 2.0, -0.6),
+        ],
+        (1, 0, 0),
+        emissive(gltf, "window", (0.9, 0.95, 1.0), 15.0),
+    )
+    cols = [(0.5, 0.1, 0.1), (0.1, 0.3, 0.5), (0.6, 0.5, 0.2), (0.2, 0.4, 0.2), (0.4, 0.4, 0.4)]
+    mats = [gs.lambertian(gltf, "book%d" % i, c) for i, c in enumerate(cols)]
+    for shelf in range(4):
+        y = 0.3 + 0.5 * shelf
+        add_box(
+            gltf,
+            "shelf%d" % shelf,
+            gs.lambertian(gltf, "wood%d" % shelf, (0.35, 0.22, 0.12)),
+            (0.5, y - 0.03, -dd + 0.2),
+            (2.6, 0.04, 0.35),
+        )
+        for b in range(14):
+            hb = 0.25 + 0.15 * ((b * 5 + shelf * 3) % 4) / 3
+            add_box(
+                gltf,
+                "book%d_%d" % (shelf, b),
+                mats[(b + shelf) % 5],
+                (-0.7 + 0.18 * b, y + hb / 2, -dd + 0.2),
+                (0.12, hb, 0.3),
+            )
+    add_sphere(
+        gltf, "globe", gltf.material("brass", (0.9, 0.7, 0.35), 1.0, 0.2), (1.2, 0.35, 0.6), 0.35
+    )
+    add_camera(gltf, (-0.5, 1.3, 1.8), (0.6, 0.9, -1.8), 55.0, 1.5)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+@scene
+def kitchen(directory):
+    """Three spot lights over a black glossy counter and a tiled splash-back, a steel bowl,
+    an orange and a wooden board."""
+    gltf = gs.Gltf("kitchen")
+    counter = gltf.material("black granite", (0.05, 0.05, 0.05), 0.0, 0.15)
+    add_quad(gltf, "counter", [(-3, 0, 3), (3, 0, 3), (3, 0, -3), (-3, 0, -3)], (0, 1, 0), counter)
+    add_quad(
+        gltf,
+        "splash",
+        [(-3, 0, -1), (3, 0, -1), (3, 2, -1), (-3, 2, -1)],
+        (0, 0, 1),
+        textured(gltf, "tiles", fine_checker_png(128, 16), roughness=0.2),
+        uv_scale=(4, 2),
+    )
+    add_sphere(
+        gltf, "bowl", gltf.material("steel", (0.8, 0.8, 0.8), 1.0, 0.1), (-0.4, 0.25, 0.0), 0.25
+    )
+    add_sphere(
+        gltf, "orange", gs.lambertian(gltf, "orange", (0.9, 0.4, 0.05)), (0.3, 0.15, 0.2), 0.15
+    )
+    add_box(
+        gltf,
+        "board",
+        textured(gltf, "wood", planks_png(), roughness=0.8),
+        (0.5, 0.03, -0.3),
+        (0.8, 0.06, 0.5),
+        yaw=10,
+    )
+    gltf.doc["extensions"] = {
+        "KHR_lights_punctual": {
+            "lights": [
+                {
+                    "name": "s%d" % i,
+                    "type": "spot",
+                    "color": [1.0, 0.9, 0.75],
+                    "intensity": 25.0,
+                    "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5},
+                }
+                for i in range(3)
+            ]
+        }
+    }
+    gltf.extensions.add("KHR_lights_punctual")
+    for i, x in enumerate((-1.0, 0.0, 1.0)):
+        p = [x, 1.8, 0.0]
+        gltf.node(
+            "s%d" % i,
+            translation=p,
+            rotation=gs.look_at_rotation(p, [x * 0.8, 0, -0.2]),
+            extensions={"KHR_lights_punctual": {"light": i}},
+        )
+    add_camera(gltf, (0.0, 1.1, 2.2), (0.0, 0.2, -0.3), 45.0, 1.5)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+@scene
+def cellar(directory):
+    """A stone cellar lit by one small, very bright lamp hidden behind a pillar, barrels and
+    a green glass bottle: indirect light and noise texture everywhere."""
+    gltf = gs.Gltf("cellar")
+    stone = textured(gltf, "stone", noise_png(), roughness=0.95)
+    w, dd, h = 2.0, 2.5, 2.0
+    closed_room(gltf, w, dd, h, stone, stone)
+    add_box(gltf, "pillar", stone, (0.3, h / 2, -0.8), (0.4, h, 0.4))
+    add_sphere(
+        gltf, "lamp", emissive(gltf, "lamp", (1.0, 0.7, 0.4), 200.0), (0.45, 1.0, -1.3), 0.05
+    )
+    for i in range(3):
+        add_box(
+            gltf,
+            "barrel%d" % i,
+            gs.lambertian(gltf, "oak%d" % i, (0.4, 0.25, 0.12)),
+            (-1.3 + 0.6 * i, 0.35, -2.0),
+            (0.5, 0.7, 0.5),
+            yaw=15 * i,
+        )
+    add_sphere(gltf, "bottle", glass(gltf, "green glass", (0.3, 0.8, 0.3)), (-0.6, 0.2, 0.3), 0.2)
+    add_camera(gltf, (0.0, 1.2, 2.2), (0.0, 0.7, -1.5), 60.0, 1.5)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
+
+@scene
+def pool(directory):
+    """A glass slab of water on a tiled ground, a red plastic and a chrome ball, for an
+    environment map."""
+    gltf = gs.Gltf("pool")
+    add_quad(
+        gltf,
+        "ground",
+        [(-6, 0, 6), (6, 0, 6), (6, 0, -6), (-6, 0, -6)],
+        (0, 1, 0),
+        textured(gltf, "tiles", fine_checker_png(128, 8), roughness=0.3),
+        uv_scale=(8, 8),
+    )
+    add_box(gltf, "water", glass(gltf, "water", (0.7, 0.9, 1.0)), (0, 0.1, 0), (3.0, 0.2, 2.0))
+    add_sphere(
+        gltf, "ball", gltf.material("red plastic", (0.8, 0.1, 0.1), 0.0, 0.2), (1.8, 0.3, 0.8), 0.3
+    )
+    add_sphere(
+        gltf,
+        "chrome",
+        gltf.material("chrome", (0.95, 0.95, 0.95), 1.0, 0.02),
+        (-1.9, 0.3, 0.6),
+        0.3,
+    )
+    add_camera(gltf, (0.0, 2.0, 3.5), (0.0, 0.0, 0.0), 45.0, 1.5)
+    gs._attach_base_color_textures(gltf)
+    gltf.write(directory, embed_buffer=True)
+
 def main():
     if len(sys.argv) != 2:
         sys.stderr.write("usage: generate_corpus_scenes.py OUTPUT_DIR\n")

@@ -6,13 +6,10 @@
 // (K = 4), against a 4096-spp reference rendered here with its own seed. Every registered member,
 // run alone on the full buffer, must beat the noisy input; every run (alone, and the held-out runs
 // the ensemble blends) writes finite, non-negative values; the ensemble of all of them must stay
-// within 1.1× of its best member (measured on 2026-12-05: 0.98×, 1.04× and 0.90× at 4, 16 and 64
-// spp; before the lens and the sky, 1.3× was allowed at 4 spp; NFOR at 16 spp keeps one firefly
-// beside the bright ball, 69 % of its error), 1.12× at 16 spp: since the guard spreads a rare
-// path's excess thin (2026-12-06) every member and the ensemble are better at 4 and 16 spp, NL
-// means most (its held-out mean 0.151 -> 0.134, the ensemble 0.1605 -> 0.1561), and the ensemble
-// of seven is 1.106× its full run. docs/outliers.md has the figures at 128×128 against a
-// 2048-spp reference.
+// within 1.1× of its best member. Measured on 2026-12-07, after the guard began to spread a
+// sparse tail over an area instead of dropping it: 0.99×, 1.00× and 0.93× at 4, 16 and 64 spp
+// (from 2026-12-06 until then 1.12× had to be allowed at 16 spp, where it was 1.06–1.11×).
+// docs/outliers.md has the history and the figures at 128×128 against a 2048-spp reference.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -84,7 +81,7 @@ TEST(StiffScene, MembersBeatTheNoisyInputAndTheEnsembleTracksTheBest) {
     const double combined = relMse(result.combined.image, reference);
     std::printf("  ensemble %.4g\n", combined);
     EXPECT_TRUE(finiteNonNegative(result.combined.image)) << spp << " spp";
-    EXPECT_LE(combined, (spp == 16 ? 1.12 : 1.1) * best) << spp << " spp";
+    EXPECT_LE(combined, 1.1 * best) << spp << " spp";
   }
 }
 

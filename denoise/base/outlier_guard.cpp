@@ -132,8 +132,8 @@ double sameOrientation(const float* a, const float* b) {
   return std::exp(-0.5 * d2 / (kSpreadNormalSigma * kSpreadNormalSigma));
 }
 
-// How much pixel q sees what pixel p sees: the product of the three similarities above over
-// the features the part holds (one it does not hold counts as the same).
+// How much pixel q sees what pixel p sees: `weight` times the three similarities above, in
+// that order, over the features the part holds (one it does not hold counts as the same).
 class WhatItSees {
  public:
   explicit WhatItSees(const SubBuffer& part)
@@ -143,8 +143,8 @@ class WhatItSees {
         hasDepth_(depth_.sameSize(part.color.mean)),
         hasAlbedo_(albedo_.sameSize(part.color.mean)),
         hasNormal_(normal_.sameSize(part.color.mean)) {}
-  double shared(int px, int py, int qx, int qy) const {
-    return (hasDepth_ ? sameSurface(depth_(px, py, 0), depth_(qx, qy, 0)) : 1.0) *
+  double shared(int px, int py, int qx, int qy, double weight = 1.0) const {
+    return weight * (hasDepth_ ? sameSurface(depth_(px, py, 0), depth_(qx, qy, 0)) : 1.0) *
            (hasAlbedo_ ? sameMaterial(albedo_.pixel(px, py), albedo_.pixel(qx, qy)) : 1.0) *
            (hasNormal_ ? sameOrientation(normal_.pixel(px, py), normal_.pixel(qx, qy)) : 1.0);
   }
@@ -387,7 +387,7 @@ class PartGuard {
         const double total = totals[size_t(it - excesses.begin())];
         for (int x = std::max(0, e.x - r); x <= std::min(w - 1, e.x + r); ++x) {
           const double share =
-              g[size_t(dy * (r + 1) + std::abs(x - e.x))] * sees.shared(e.x, e.y, x, y) / total;
+              sees.shared(e.x, e.y, x, y, g[size_t(dy * (r + 1) + std::abs(x - e.x))]) / total;
           float& m = out.mean(x, y, e.c);
           m = float(std::min(double(m) + e.amount * share, double(kMaxFloat)));
           changed[size_t(y) * size_t(w) + size_t(x)] = 1;

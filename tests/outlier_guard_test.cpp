@@ -58,6 +58,18 @@ double channelSum(const Image& image) {
   return sum;
 }
 
+// The guard clamps outliers of `s` and keeps the image's sum to 1e-5, and the peaks are gone: no
+// value above a fifth of one outlier's contribution to its pixel's mean.
+void expectSpreadKeepingTheEnergy(const SubBuffer& s, float contribution) {
+  const GuardedInput g = guardOutliers(wholeOnly(s));
+  EXPECT_GT(g.clampedValues, 0u);
+  const double before = channelSum(s.color.mean), after = channelSum(g.input.whole.color.mean);
+  EXPECT_NEAR(after, before, 1e-5 * before);
+  float largest = 0;
+  for (float v : g.input.whole.color.mean.values()) largest = std::max(largest, v);
+  EXPECT_LT(largest, 0.2f * contribution);
+}
+
 TEST(OutlierGuard, OrdinaryNoiseIsNeverTouched) {
   const SubBuffer s = fromSamples(24, 24, [](int x, int y) { return ordinary(x, y, 1); });
   const GuardedInput g = guardOutliers(wholeOnly(s));
@@ -118,14 +130,7 @@ TEST(OutlierGuard, FirefliesWithPeersKeepTheirEnergy) {
     if (x >= 12 && x < 28 && y >= 12 && y < 28 && (3 * x + 5 * y) % 11 == 0) v[0] = 300.0;
     return v;
   });
-  const GuardedInput g = guardOutliers(wholeOnly(s));
-  EXPECT_GT(g.clampedValues, 0u);
-  const double before = channelSum(s.color.mean), after = channelSum(g.input.whole.color.mean);
-  EXPECT_NEAR(after, before, 1e-5 * before);
-  // …and the peaks are gone: no value above a fifth of the firefly's contribution.
-  float largest = 0;
-  for (float v : g.input.whole.color.mean.values()) largest = std::max(largest, v);
-  EXPECT_LT(largest, 0.2f * 300.0f / 4.0f);
+  expectSpreadKeepingTheEnergy(s, 300.0f / 4.0f);
 }
 
 // A wall lit only by rare paths (docs/outliers.md's corridor at 4 spp): every sample is 0 but
@@ -146,13 +151,7 @@ SubBuffer sparseTail(const std::function<float(int x, int y)>& depth) {
 
 TEST(OutlierGuard, ASparseTailOverAnAreaKeepsItsEnergy) {
   const SubBuffer s = sparseTail([](int, int) { return 2.0f; });
-  const GuardedInput g = guardOutliers(wholeOnly(s));
-  EXPECT_GT(g.clampedValues, 0u);
-  const double before = channelSum(s.color.mean), after = channelSum(g.input.whole.color.mean);
-  EXPECT_NEAR(after, before, 1e-5 * before);
-  float largest = 0;
-  for (float v : g.input.whole.color.mean.values()) largest = std::max(largest, v);
-  EXPECT_LT(largest, 0.2f * 200.0f / 4.0f);
+  expectSpreadKeepingTheEnergy(s, 200.0f / 4.0f);
 }
 
 // The same samples, but every 5 × 5 block is a surface of its own depth (1.5 times or less

@@ -132,26 +132,27 @@ double sameOrientation(const float* a, const float* b) {
   return std::exp(-0.5 * d2 / (kSpreadNormalSigma * kSpreadNormalSigma));
 }
 
-// How much pixel q sees what pixel p sees: `weight` times the three similarities above, in
-// that order, over the features the part holds (one it does not hold counts as the same).
+// How much the pixels q around a pixel p see what p sees: `weight` times the three similarities
+// above, in that order, over the features the part holds (one it does not hold counts as the
+// same). p's own features are looked up once.
 class WhatItSees {
  public:
-  explicit WhatItSees(const SubBuffer& part)
+  WhatItSees(const SubBuffer& part, int px, int py)
       : depth_(part.depth.mean),
         albedo_(part.albedo.mean),
         normal_(part.normal.mean),
-        hasDepth_(depth_.sameSize(part.color.mean)),
-        hasAlbedo_(albedo_.sameSize(part.color.mean)),
-        hasNormal_(normal_.sameSize(part.color.mean)) {}
-  double shared(int px, int py, int qx, int qy, double weight = 1.0) const {
-    return weight * (hasDepth_ ? sameSurface(depth_(px, py, 0), depth_(qx, qy, 0)) : 1.0) *
-           (hasAlbedo_ ? sameMaterial(albedo_.pixel(px, py), albedo_.pixel(qx, qy)) : 1.0) *
-           (hasNormal_ ? sameOrientation(normal_.pixel(px, py), normal_.pixel(qx, qy)) : 1.0);
+        here_(depth_.sameSize(part.color.mean) ? depth_.pixel(px, py) : nullptr),
+        material_(albedo_.sameSize(part.color.mean) ? albedo_.pixel(px, py) : nullptr),
+        facing_(normal_.sameSize(part.color.mean) ? normal_.pixel(px, py) : nullptr) {}
+  double shared(int qx, int qy, double weight = 1.0) const {
+    return weight * (here_ ? sameSurface(*here_, depth_(qx, qy, 0)) : 1.0) *
+           (material_ ? sameMaterial(material_, albedo_.pixel(qx, qy)) : 1.0) *
+           (facing_ ? sameOrientation(facing_, normal_.pixel(qx, qy)) : 1.0);
   }
 
  private:
   const Image &depth_, &albedo_, &normal_;
-  bool hasDepth_, hasAlbedo_, hasNormal_;
+  const float *here_, *material_, *facing_;
 };
 
 // The value exceeded by exactly `rank` of values[0 … count) (0: the largest), for a small rank:
@@ -307,15 +308,16 @@ class PartGuard {
   bool tailFillsTheWindow(int x, int y, int c, double level, double excess) const {
     const Image& mean = part_.color.mean;
     const int w = mean.width(), h = mean.height(), r = o_.spreadRadius;
-    const WhatItSees sees(part_);
-    double mass = 0, sw = excess, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+    const WhatItSees sees(part_, x, y);
+    // Excess-weighted sums over the peers and the outlier at (0, 0): their weight, the peers'
+    // share of it being sw − excess, and the first and second moments of their positions.
+    double sw = excess, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
     for (int qy = std::max(0, y - r); qy <= std::min(h - 1, y + r); ++qy)
       for (int qx = std::max(0, x - r); qx <= std::min(w - 1, x + r); ++qx) {
         const double d = double(mean(qx, qy, c)) - level;
         if ((qx == x && qy == y) || !(std::isfinite(d) && d * kPeerFraction >= excess)) continue;
-        const double m = d * sees.shared(x, y, qx, qy);
+        const double m = d * sees.shared(qx, qy);
         const double dx = qx - x, dy = qy - y;
-        mass += m;
         sw += m;
         sx += m * dx;
         sy += m * dy;
@@ -323,7 +325,7 @@ class PartGuard {
         syy += m * dy * dy;
         sxy += m * dx * dy;
       }
-    if (!(mass >= excess)) return false;
+    if (!(sw - excess >= excess)) return false;
     const double mx = sx / sw, my = sy / sw;
     const double a = sxx / sw - mx * mx, b = sxy / sw - mx * my, d = syy / sw - my * my;
     const double smaller = 0.5 * (a + d) - std::sqrt(0.25 * (a - d) * (a - d) + b * b);
@@ -374,7 +376,6 @@ class PartGuard {
         totals[i] = total;
       }
     });
-    const WhatItSees sees(part_);
     parallelRows(0, h, [&](int y) {
       // The excesses whose windows can reach row y: e.y within kMaxGuardSpread of it.
       auto first = std::lower_bound(excesses.begin(), excesses.end(), y - kMaxGuardSpread,
@@ -385,9 +386,10 @@ class PartGuard {
         if (dy > r) continue;
         const std::vector<double>& g = kernels.byRadius[size_t(r)];
         const double total = totals[size_t(it - excesses.begin())];
+        const WhatItSees sees(part_, e.x, e.y);
         for (int x = std::max(0, e.x - r); x <= std::min(w - 1, e.x + r); ++x) {
           const double share =
-              sees.shared(e.x, e.y, x, y, g[size_t(dy * (r + 1) + std::abs(x - e.x))]) / total;
+              sees.shared(x, y, g[size_t(dy * (r + 1) + std::abs(x - e.x))]) / total;
           float& m = out.mean(x, y, e.c);
           m = float(std::min(double(m) + e.amount * share, double(kMaxFloat)));
           changed[size_t(y) * size_t(w) + size_t(x)] = 1;
